@@ -1,0 +1,547 @@
+/*
+ * rangecast — range sensor simulation by ray tracing triangle meshes.
+ *
+ * This header is the whole public API and its manual. C99, plain C ABI, also
+ * compiles as C++.
+ *
+ * Example: one VLP-16 scan of a mesh held in the caller's arrays.
+ *
+ *     rc_context_desc cd = rc_context_desc_default();
+ *     rc_context *ctx = NULL;
+ *     if (rc_context_create(&cd, &ctx) != RC_OK) return 1;   // one malloc here
+ *
+ *     rc_scene_desc sd = rc_scene_desc_default();
+ *     sd.max_geometries = 1; sd.max_triangles = ntri; sd.max_vertices = nvert;
+ *     rc_scene *scene = NULL;
+ *     rc_scene_create(ctx, &sd, &scene);
+ *
+ *     rc_mesh_desc md = rc_mesh_desc_default();
+ *     md.vertices = verts; md.vertex_count = nvert;           // float x,y,z
+ *     md.indices = tris;   md.triangle_count = ntri;          // uint32 x3
+ *     uint32_t geom = 0;
+ *     rc_scene_add_mesh(scene, &md, &geom);
+ *     rc_scene_commit(scene);                                  // builds the BVH
+ *
+ *     rc_sensor *lidar = NULL;
+ *     rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &lidar);
+ *
+ *     rc_pose pose = {{0, 0, 1}, {0, 0, 0, 1}};                // base-to-map
+ *     static float ranges[16 * 900];
+ *     rc_results res = rc_results_default();
+ *     res.attributes = RC_ATTR_RANGES;
+ *     res.ranges = ranges; res.capacity = 16 * 900;
+ *     if (rc_simulate(ctx, scene, lidar, &pose, 1, &res) != RC_OK)
+ *         fprintf(stderr, "%s\n", rc_context_last_error(ctx));
+ *     rc_context_destroy(ctx);       // frees scenes and sensors too
+ *
+ * Conventions used throughout:
+ * - Every call that can fail returns rc_status: RC_OK (0) or a negative error.
+ *   On failure nothing is written to the caller's output buffers and out-params
+ *   keep their previous value, and rc_context_last_error() names the argument.
+ * - Every create call takes a descriptor whose first field is struct_size; get one
+ *   from rc_<x>_desc_default(). Zero in a field means "default". reserved words
+ *   must be zero.
+ * - Enumerations are plain uint32_t constants (public layout never depends on
+ *   the compiler's enum size or on build options).
+ * - Frames: right-handed, x forward, y left, z up (REP 103) unless a field says
+ *   otherwise. Quaternions are (x, y, z, w). Lengths in metres, angles in radians.
+ * - Thread rules: a context, and everything created from it, is used by one
+ *   thread at a time, unless a function says otherwise. Functions without a
+ *   context argument are thread-safe.
+ * - Memory tiers: with the built-in BVH backend the library allocates only inside
+ *   the context's arena (a block the caller hands in, or one malloc at context
+ *   creation), and never after rc_context_create. The Embree and Vulkan backends
+ *   allocate internally as well; their use is reported in rc_memory_stats.
+ */
+#ifndef RANGECAST_H
+#define RANGECAST_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32) && defined(RANGECAST_SHARED)
+#  if defined(RANGECAST_BUILDING)
+#    define RC_API __declspec(dllexport)
+#  else
+#    define RC_API __declspec(dllimport)
+#  endif
+#elif defined(__GNUC__) && defined(RANGECAST_BUILDING)
+#  define RC_API __attribute__((visibility("default")))
+#else
+#  define RC_API
+#endif
+
+/* ------------------------------------------------------------------------ */
+/* Version                                                                   */
+/* ------------------------------------------------------------------------ */
+
+#define RC_VERSION_MAJOR 0
+#define RC_VERSION_MINOR 1
+#define RC_VERSION_PATCH 0
+/* MAJOR * 10000 + MINOR * 100 + PATCH. */
+#define RC_VERSION_NUMBER (RC_VERSION_MAJOR * 10000 + RC_VERSION_MINOR * 100 + RC_VERSION_PATCH)
+
+/* The RC_VERSION_NUMBER the library was built with; bindings compare it with
+ * the header they were built against. Thread-safe. */
+RC_API uint32_t rc_version_number(void);
+/* "MAJOR.MINOR.PATCH", static storage. Thread-safe. */
+RC_API const char *rc_version_string(void);
+
+/* ------------------------------------------------------------------------ */
+/* Status codes. These values are pinned: they never change once released.   */
+/* ------------------------------------------------------------------------ */
+
+typedef int32_t rc_status;
+
+#define RC_OK                      0
+#define RC_ERR_INVALID_ARGUMENT   (-1)  /* a NULL pointer, a zero count, a value out of its domain */
+#define RC_ERR_INVALID_HANDLE     (-2)  /* a handle that is NULL, destroyed or of another kind      */
+#define RC_ERR_MISUSE             (-3)  /* a call at the wrong time (e.g. adding to a full scene)   */
+#define RC_ERR_OUT_OF_MEMORY      (-4)  /* the arena (or the system) has no room                    */
+#define RC_ERR_CAPACITY           (-5)  /* more than the object was created to hold                 */
+#define RC_ERR_UNSUPPORTED        (-6)  /* a backend or feature not built in or not available here  */
+#define RC_ERR_BACKEND            (-7)  /* the backend library reported an error (message says it)  */
+#define RC_ERR_DEVICE_LOST        (-8)  /* the GPU device was lost; only destroy is allowed after   */
+#define RC_ERR_CORRUPT_DATA       (-9)  /* a file or blob that fails its checks                     */
+#define RC_ERR_NOT_COMMITTED     (-10)  /* a scene used before rc_scene_commit, or changed since    */
+#define RC_ERR_NON_FINITE        (-11)  /* NaN or infinity in vertices, poses or parameters         */
+#define RC_ERR_OUT_OF_RANGE      (-12)  /* an index (e.g. a triangle's vertex) past its array       */
+#define RC_ERR_STRUCT_SIZE       (-13)  /* a descriptor's struct_size this library does not know    */
+#define RC_ERR_IO                (-14)  /* a file could not be read or written                      */
+
+/* Static text for a status ("RC_ERR_OUT_OF_MEMORY: ..."). Never NULL. Thread-safe. */
+RC_API const char *rc_status_string(rc_status status);
+
+/* ------------------------------------------------------------------------ */
+/* Common types                                                              */
+/* ------------------------------------------------------------------------ */
+
+/* Rigid transform: rotate by the unit quaternion, then translate.
+ * Layout is exactly 7 floats, x y z qx qy qz qw: a raw pose file maps onto an
+ * array of rc_pose. Quaternions are normalised by the library when their norm
+ * is within 1e-3 of 1; farther off (or zero, NaN, inf) is RC_ERR_NON_FINITE or
+ * RC_ERR_INVALID_ARGUMENT. */
+typedef struct rc_pose {
+    float position[3];
+    float orientation[4]; /* x, y, z, w */
+} rc_pose;
+
+/* Identity pose (0,0,0; 0,0,0,1). Thread-safe. */
+RC_API rc_pose rc_pose_identity(void);
+
+/* Log callback: level is one of RC_LOG_*. The library never prints. */
+#define RC_LOG_ERROR 1u
+#define RC_LOG_WARN  2u
+#define RC_LOG_INFO  3u
+#define RC_LOG_DEBUG 4u
+typedef void (*rc_log_fn)(void *user, uint32_t level, const char *message);
+
+/* Progress callback for long work (a large commit). fraction in [0,1]. Return
+ * non-zero to keep going; there is no cancel yet (the return is reserved). */
+typedef int (*rc_progress_fn)(void *user, const char *stage, double fraction);
+
+/* ------------------------------------------------------------------------ */
+/* Context                                                                   */
+/* ------------------------------------------------------------------------ */
+
+typedef struct rc_context rc_context;
+
+#define RC_BACKEND_DEFAULT 0u /* = AUTO */
+#define RC_BACKEND_AUTO    0u /* Embree when built in, else the built-in BVH */
+#define RC_BACKEND_BVH     1u /* built-in SAH BVH, always present */
+#define RC_BACKEND_EMBREE  2u
+#define RC_BACKEND_VULKAN  3u
+
+typedef struct rc_context_desc {
+    uint32_t struct_size;   /* sizeof(rc_context_desc) */
+    uint32_t backend;       /* RC_BACKEND_*; 0 = AUTO */
+    uint32_t thread_count;  /* 0 = number of online CPUs; 1 = run on the caller's thread */
+    uint32_t flags;         /* none yet: must be 0 */
+    /* The arena. memory != NULL: the caller's block of memory_size bytes,
+     * aligned to 16 (RC_ARENA_ALIGNMENT); the library never calls malloc.
+     * memory == NULL: the library mallocs memory_size bytes once, here
+     * (0 = RC_DEFAULT_ARENA_SIZE). Size it with rc_*_memory_requirements. */
+    void *memory;
+    size_t memory_size;
+    rc_log_fn log;          /* optional */
+    void *log_user;
+    uint32_t reserved[8];   /* must be 0 */
+} rc_context_desc;
+
+#define RC_ARENA_ALIGNMENT 16u
+#define RC_DEFAULT_ARENA_SIZE ((size_t)256 << 20)
+/* Hard upper bound on thread_count. */
+#define RC_MAX_THREADS 256u
+
+/* A desc with struct_size set and every other field 0 (defaults). Thread-safe. */
+RC_API rc_context_desc rc_context_desc_default(void);
+
+/* Bytes of arena the context itself takes (its bookkeeping, the per-thread
+ * scratch), before any scene or sensor. Add the scene and sensor requirements to
+ * size one block for all of them. Thread-safe.
+ * Returns RC_ERR_INVALID_ARGUMENT (NULL), RC_ERR_STRUCT_SIZE, RC_ERR_UNSUPPORTED
+ * (backend not built in). */
+RC_API rc_status rc_context_memory_requirements(const rc_context_desc *desc, size_t *bytes);
+
+/* Creates a context: checks the desc, sets up the arena (one malloc when no
+ * block is given), starts thread_count - 1 worker threads, initialises the
+ * backend. *out is set only on RC_OK.
+ * Returns RC_ERR_INVALID_ARGUMENT, RC_ERR_STRUCT_SIZE, RC_ERR_OUT_OF_MEMORY
+ * (block too small or malloc failed), RC_ERR_UNSUPPORTED (backend absent or no
+ * device), RC_ERR_BACKEND. Thread-safe (it touches no shared state). */
+RC_API rc_status rc_context_create(const rc_context_desc *desc, rc_context **out);
+
+/* Destroys the context, every scene and sensor created from it, joins the
+ * threads, and frees the malloc'd arena (a caller's block is the caller's to
+ * free). NULL is a no-op. */
+RC_API void rc_context_destroy(rc_context *ctx);
+
+/* The message of the last failed call on this context or on an object created
+ * from it ("" when none). Valid until the next call on the context. */
+RC_API const char *rc_context_last_error(const rc_context *ctx);
+
+/* The backend actually in use (RC_BACKEND_BVH, _EMBREE or _VULKAN). */
+RC_API rc_status rc_context_get_backend(const rc_context *ctx, uint32_t *backend);
+/* Number of threads simulate uses (the caller's thread included). */
+RC_API rc_status rc_context_get_thread_count(const rc_context *ctx, uint32_t *count);
+
+/* Memory figures, all in bytes. */
+typedef struct rc_memory_stats {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    uint64_t arena_size;       /* size of the arena block */
+    uint64_t arena_used;       /* bytes allocated in it now (headers included) */
+    uint64_t arena_peak;       /* high-water mark of arena_used */
+    uint64_t backend_bytes;    /* memory the backend library holds outside the arena (Embree, Vulkan host) */
+    uint64_t device_bytes;     /* GPU memory held (Vulkan) */
+    uint64_t reserved[4];
+} rc_memory_stats;
+
+/* Fills stats (stats->struct_size must be set, as by rc_memory_stats_default). */
+RC_API rc_memory_stats rc_memory_stats_default(void);
+RC_API rc_status rc_context_get_memory_stats(const rc_context *ctx, rc_memory_stats *stats);
+
+/* Is this backend compiled into the library? (It may still fail at create if,
+ * e.g., no Vulkan device is present.) Thread-safe. */
+RC_API int rc_backend_available(uint32_t backend);
+/* "bvh", "embree", "vulkan", "auto" or "unknown". Thread-safe. */
+RC_API const char *rc_backend_name(uint32_t backend);
+
+/* ------------------------------------------------------------------------ */
+/* Scenes                                                                    */
+/* ------------------------------------------------------------------------ */
+
+typedef struct rc_scene rc_scene;
+
+/* A scene is created with fixed capacities; its arena memory is reserved at
+ * create (tables, copies) and at commit (acceleration structure). */
+typedef struct rc_scene_desc {
+    uint32_t struct_size;
+    uint32_t max_geometries;   /* meshes this scene can hold (0 = 1) */
+    uint32_t max_instances;    /* instances this scene can hold (0 = none) */
+    uint32_t flags;            /* none yet: 0 */
+    uint64_t max_triangles;    /* sum of triangles over all its meshes */
+    uint64_t max_vertices;     /* sum of vertices over meshes added with RC_MESH_COPY */
+    uint64_t max_copied_triangles; /* sum of triangles over meshes added with RC_MESH_COPY */
+    uint32_t reserved[8];
+} rc_scene_desc;
+
+RC_API rc_scene_desc rc_scene_desc_default(void);
+
+/* Exact arena bytes a scene with these capacities takes at its peak (create +
+ * commit, build scratch included) on the context's backend: a context whose
+ * arena has rc_context_memory_requirements + this (+ sensors) free can create,
+ * fill and commit it; one byte less fails with RC_ERR_OUT_OF_MEMORY. The
+ * figure holds when objects are created in order on a fresh context (no holes
+ * left by destroyed objects). For the BVH backend only; other backends also
+ * allocate internally. */
+RC_API rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_desc *desc,
+                                              size_t *bytes);
+
+/* Creates an empty scene in the context's arena. */
+RC_API rc_status rc_scene_create(rc_context *ctx, const rc_scene_desc *desc, rc_scene **out);
+/* Frees the scene's memory. A scene still instanced by another scene cannot be
+ * destroyed (RC_ERR_MISUSE). NULL is a no-op returning RC_OK. */
+RC_API rc_status rc_scene_destroy(rc_scene *scene);
+
+#define RC_MESH_REFERENCE 0u  /* default: the arrays are used in place; keep them alive and unchanged */
+#define RC_MESH_COPY      1u  /* the arrays are copied into the arena */
+
+typedef struct rc_mesh_desc {
+    uint32_t struct_size;
+    uint32_t flags;             /* RC_MESH_REFERENCE or RC_MESH_COPY */
+    const float *vertices;      /* x, y, z per vertex */
+    uint64_t vertex_count;
+    uint32_t vertex_stride;     /* bytes between vertices; 0 = 12. Multiple of 4. */
+    uint32_t reserved0;
+    const uint32_t *indices;    /* 3 vertex indices per triangle */
+    uint64_t triangle_count;
+    uint32_t reserved[8];
+} rc_mesh_desc;
+
+RC_API rc_mesh_desc rc_mesh_desc_default(void);
+
+/* Adds a triangle mesh. Checks every vertex is finite (RC_ERR_NON_FINITE) and
+ * every index is < vertex_count (RC_ERR_OUT_OF_RANGE) and zero counts
+ * (RC_ERR_INVALID_ARGUMENT). *geom_id is its geometry id in this scene
+ * (0, 1, 2 ... in order of adding). The scene must be committed afterwards.
+ * Degenerate (zero-area) triangles are allowed and never hit. */
+RC_API rc_status rc_scene_add_mesh(rc_scene *scene, const rc_mesh_desc *desc, uint32_t *geom_id);
+
+/* Tells the scene a referenced mesh's vertices changed (same counts). The next
+ * commit refits that mesh's BVH instead of rebuilding it. */
+RC_API rc_status rc_scene_update_mesh(rc_scene *scene, uint32_t geom_id);
+
+/* An instance places another scene (holding meshes only, committed) in this one. */
+typedef struct rc_instance_desc {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    const rc_scene *source;     /* committed scene of meshes; no instances of instances */
+    rc_pose transform;          /* source-to-this-scene, applied after scale */
+    float scale[3];             /* per-axis scale; 0 in all three = 1 (uniform use: set all three) */
+    uint32_t reserved[8];
+} rc_instance_desc;
+
+RC_API rc_instance_desc rc_instance_desc_default(void);
+
+/* Adds an instance; *inst_id is its id (0, 1, 2 ... in order). Scale must be
+ * non-zero and finite in every axis once set. */
+RC_API rc_status rc_scene_add_instance(rc_scene *scene, const rc_instance_desc *desc, uint32_t *inst_id);
+/* Moves an instance (dynamic maps); takes effect at the next commit, which only
+ * rebuilds the top level. */
+RC_API rc_status rc_scene_set_instance_transform(rc_scene *scene, uint32_t inst_id,
+                                                 const rc_pose *transform, const float scale[3]);
+
+/* Builds (or refits) the acceleration structure. Needed after any add/update/set
+ * before simulate. progress may be NULL. Returns RC_ERR_OUT_OF_MEMORY when the
+ * arena cannot hold the structure (the scene then stays uncommitted),
+ * RC_ERR_INVALID_ARGUMENT for an empty scene, RC_ERR_NOT_COMMITTED when an
+ * instanced source scene is not committed. */
+RC_API rc_status rc_scene_commit(rc_scene *scene);
+RC_API rc_status rc_scene_commit_with_progress(rc_scene *scene, rc_progress_fn progress, void *user);
+
+/* Axis-aligned bounds of the committed scene (min xyz, max xyz). */
+RC_API rc_status rc_scene_get_bounds(const rc_scene *scene, float bounds[6]);
+
+/* Counts of a scene as added (not necessarily committed). */
+typedef struct rc_scene_info {
+    uint32_t struct_size;
+    uint32_t geometry_count;
+    uint32_t instance_count;
+    uint32_t committed;         /* 1 when simulate can use it */
+    uint64_t triangle_count;    /* own meshes only */
+    uint64_t bvh_nodes;         /* nodes in the built-in structure (0 for other backends) */
+    uint64_t bytes;             /* arena bytes the scene holds now */
+    uint64_t reserved[4];
+} rc_scene_info;
+RC_API rc_scene_info rc_scene_info_default(void);
+RC_API rc_status rc_scene_get_info(const rc_scene *scene, rc_scene_info *info);
+
+/* ------------------------------------------------------------------------ */
+/* Sensors                                                                   */
+/* ------------------------------------------------------------------------ */
+
+typedef struct rc_sensor rc_sensor;
+
+#define RC_SENSOR_SPHERICAL   1u
+#define RC_SENSOR_PINHOLE     2u
+#define RC_SENSOR_CYLINDRICAL 3u
+#define RC_SENSOR_O1DN        4u
+#define RC_SENSOR_ONDN        5u
+
+/* Fields every sensor has. */
+typedef struct rc_sensor_common {
+    float range_min;         /* hits nearer than this read -inf (REP 117); >= 0 */
+    float range_max;         /* no hit within this reads +inf; > range_min */
+    rc_pose sensor_to_base;  /* mounting: sensor frame in the robot's base frame */
+} rc_sensor_common;
+
+/* An angle axis: count values min, min + increment, ... */
+typedef struct rc_angle_axis {
+    float min;
+    float increment;
+    uint32_t count;
+} rc_angle_axis;
+
+/* Spherical (spinning LiDARs). Ray (row i, column j), i < phi.count, j < theta.count:
+ *   theta = theta.min + j * theta.increment   (horizontal, about z, from x towards y)
+ *   phi   = phi.min + i * phi.increment       (vertical, up from the x-y plane)
+ *   direction = (cos phi cos theta, cos phi sin theta, sin phi)
+ * Index of the ray in a scan: i * theta.count + j. */
+typedef struct rc_spherical_desc {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    rc_sensor_common common;
+    rc_angle_axis theta;
+    rc_angle_axis phi;
+    uint32_t reserved[8];
+} rc_spherical_desc;
+
+/* Pinhole (depth cameras). Pixel (u = column, v = row), with no half-pixel offset:
+ *   optical ray o = ((u - cx) / fx, (v - cy) / fy, 1)   (z forward, x right, y down)
+ * frame RC_PINHOLE_FRAME_BODY (default): the sensor frame is x forward, y left,
+ *   z up, and the direction is normalize(o.z, -o.x, -o.y);
+ * frame RC_PINHOLE_FRAME_OPTICAL: the sensor frame is the ROS optical frame
+ *   (z forward, x right, y down) and the direction is normalize(o); points and
+ *   normals come out in that frame, as ROS depth images expect.
+ * ranges are along the ray (not depth z); depth = range * cos(angle to axis).
+ * Index: v * width + u. */
+#define RC_PINHOLE_FRAME_BODY    0u
+#define RC_PINHOLE_FRAME_OPTICAL 1u
+typedef struct rc_pinhole_desc {
+    uint32_t struct_size;
+    uint32_t frame;          /* RC_PINHOLE_FRAME_* */
+    rc_sensor_common common;
+    uint32_t width, height;
+    float fx, fy, cx, cy;    /* pixels */
+    uint32_t reserved[8];
+} rc_pinhole_desc;
+
+/* Cylindrical (panoramic cameras, rotating line scanners). Ray (row v, column j):
+ *   theta = theta.min + j * theta.increment
+ *   h     = (cy - v) / fy              (height on a unit-radius cylinder, up is +)
+ *   direction = normalize(cos theta, sin theta, h)
+ * Index: v * theta.count + j. */
+typedef struct rc_cylindrical_desc {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    rc_sensor_common common;
+    rc_angle_axis theta;
+    uint32_t height;         /* rows */
+    float fy, cy;            /* vertical focal length and centre row, pixels */
+    uint32_t reserved[8];
+} rc_cylindrical_desc;
+
+/* O1Dn: one origin (the sensor frame's), any directions (e.g. Livox rosettes).
+ * OnDn: a ray origin per direction too (sensor frame). Directions need not be
+ * unit: they are normalised (a zero direction is RC_ERR_INVALID_ARGUMENT).
+ * width * height = ray_count lets tools show the scan as an image; 0, 0 means
+ * (ray_count, 1). The arrays are copied into the arena at create. */
+typedef struct rc_rays_desc {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    rc_sensor_common common;
+    const float *directions; /* 3 per ray */
+    const float *origins;    /* 3 per ray: OnDn only (NULL for O1Dn) */
+    uint32_t ray_count;
+    uint32_t width, height;
+    uint32_t reserved[8];
+} rc_rays_desc;
+
+RC_API rc_spherical_desc rc_spherical_desc_default(void);
+RC_API rc_pinhole_desc rc_pinhole_desc_default(void);
+RC_API rc_cylindrical_desc rc_cylindrical_desc_default(void);
+RC_API rc_rays_desc rc_rays_desc_default(void);
+
+/* Exact arena bytes a sensor takes (its precomputed ray table). */
+RC_API rc_status rc_sensor_memory_requirements_spherical(const rc_spherical_desc *desc, size_t *bytes);
+RC_API rc_status rc_sensor_memory_requirements_pinhole(const rc_pinhole_desc *desc, size_t *bytes);
+RC_API rc_status rc_sensor_memory_requirements_cylindrical(const rc_cylindrical_desc *desc, size_t *bytes);
+RC_API rc_status rc_sensor_memory_requirements_rays(uint32_t model, const rc_rays_desc *desc, size_t *bytes);
+
+/* Creators. Each checks every field (non-finite: RC_ERR_NON_FINITE; zero
+ * counts, range_min >= range_max, negative ranges, fx <= 0 ...:
+ * RC_ERR_INVALID_ARGUMENT) and precomputes the direction table in the arena. */
+RC_API rc_status rc_sensor_create_spherical(rc_context *ctx, const rc_spherical_desc *desc, rc_sensor **out);
+RC_API rc_status rc_sensor_create_pinhole(rc_context *ctx, const rc_pinhole_desc *desc, rc_sensor **out);
+RC_API rc_status rc_sensor_create_cylindrical(rc_context *ctx, const rc_cylindrical_desc *desc, rc_sensor **out);
+/* model: RC_SENSOR_O1DN or RC_SENSOR_ONDN. */
+RC_API rc_status rc_sensor_create_rays(rc_context *ctx, uint32_t model, const rc_rays_desc *desc, rc_sensor **out);
+/* NULL is a no-op. */
+RC_API rc_status rc_sensor_destroy(rc_sensor *sensor);
+
+/* Presets. */
+#define RC_PRESET_VELODYNE_VLP16   1u /* spherical 16 x 900: phi -15..+15 deg step 2, theta from -180 deg step 0.4, 0.5..130 m */
+#define RC_PRESET_OUSTER_OS1_64    2u /* spherical 64 x 1024: phi -22.5..+22.5 deg (45/63 step), 0.3..120 m */
+#define RC_PRESET_REALSENSE_D435   3u /* pinhole 848 x 480, 87 x 58 deg field of view, 0.1..10 m, body frame */
+#define RC_PRESET_LIVOX_MID40      4u /* O1Dn rosette, 38.4 deg circular field of view, 10,000 rays, 0.1..260 m */
+#define RC_PRESET_VELODYNE_VLP16_360 5u /* as VLP16 with 360 columns (1 deg) */
+
+/* Looks a preset up by name: "vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40".
+ * Returns 0 when unknown. Thread-safe. */
+RC_API uint32_t rc_preset_from_name(const char *name);
+/* The preset's model (RC_SENSOR_*), 0 when unknown. Thread-safe. */
+RC_API uint32_t rc_preset_model(uint32_t preset);
+/* Fill a desc with the preset (the model must match: RC_ERR_INVALID_ARGUMENT
+ * otherwise). The caller may change fields before creating. Thread-safe. */
+RC_API rc_status rc_preset_spherical(uint32_t preset, rc_spherical_desc *desc);
+RC_API rc_status rc_preset_pinhole(uint32_t preset, rc_pinhole_desc *desc);
+/* Writes the preset's 3 * count floats of directions (count = the preset's ray
+ * count, given by *count on return when directions is NULL). */
+RC_API rc_status rc_preset_rays(uint32_t preset, rc_rays_desc *desc, float *directions, uint32_t *count);
+/* Creates any preset directly (the O1Dn ones generate their directions). */
+RC_API rc_status rc_sensor_create_preset(rc_context *ctx, uint32_t preset, rc_sensor **out);
+RC_API rc_status rc_sensor_memory_requirements_preset(uint32_t preset, size_t *bytes);
+
+/* Shape of a sensor's scan. */
+typedef struct rc_sensor_info {
+    uint32_t struct_size;
+    uint32_t model;          /* RC_SENSOR_* */
+    uint32_t rows;           /* grid rows (height), 1 for flat O1Dn/OnDn */
+    uint32_t columns;        /* grid columns (width) */
+    uint32_t rays_per_scan;  /* rows * columns */
+    float range_min, range_max;
+    uint32_t reserved[5];
+} rc_sensor_info;
+RC_API rc_sensor_info rc_sensor_info_default(void);
+RC_API rc_status rc_sensor_get_info(const rc_sensor *sensor, rc_sensor_info *info);
+
+/* Moves the sensor on the robot (takes effect at the next simulate). */
+RC_API rc_status rc_sensor_set_mounting(rc_sensor *sensor, const rc_pose *sensor_to_base);
+
+/* ------------------------------------------------------------------------ */
+/* Simulate                                                                  */
+/* ------------------------------------------------------------------------ */
+
+#define RC_ATTR_HITS     0x01u /* uint8: 1 = a valid return within [range_min, range_max] */
+#define RC_ATTR_RANGES   0x02u /* float: metres; +inf no return, -inf nearer than range_min (REP 117) */
+#define RC_ATTR_POINTS   0x04u /* float x3: sensor frame; NaN where hit is 0 */
+#define RC_ATTR_NORMALS  0x08u /* float x3: sensor frame, unit, facing the sensor; NaN where hit is 0 */
+#define RC_ATTR_PRIM_IDS 0x10u /* uint32: triangle index within its mesh; RC_INVALID_ID where hit is 0 */
+#define RC_ATTR_GEOM_IDS 0x20u /* uint32: geometry id within its scene; RC_INVALID_ID where hit is 0 */
+#define RC_ATTR_INST_IDS 0x40u /* uint32: instance id; RC_INVALID_ID where hit is 0 or the mesh is not instanced */
+#define RC_ATTR_ALL      0x7Fu
+
+#define RC_INVALID_ID 0xFFFFFFFFu
+
+/* The caller's result buffers, one array per attribute. Element k of a batch is
+ * pose * rays_per_scan + ray (for grid sensors ray = row * columns + column);
+ * points and normals hold 3 floats per element. Every requested buffer must hold
+ * capacity elements, capacity >= pose_count * rays_per_scan. Buffers of
+ * attributes not requested are ignored and left untouched. */
+typedef struct rc_results {
+    uint32_t struct_size;
+    uint32_t attributes;     /* RC_ATTR_* mask */
+    uint64_t capacity;       /* elements each requested buffer holds */
+    uint8_t *hits;
+    float *ranges;
+    float *points;
+    float *normals;
+    uint32_t *prim_ids;
+    uint32_t *geom_ids;
+    uint32_t *inst_ids;
+    uint32_t reserved[8];
+} rc_results;
+
+RC_API rc_results rc_results_default(void);
+
+/* Simulates the sensor at pose_count poses (base-to-map) in a committed scene
+ * and writes the requested attributes. All arguments are checked before
+ * anything is written: NULL handles (RC_ERR_INVALID_HANDLE), a scene and sensor
+ * of another context (RC_ERR_INVALID_ARGUMENT), an uncommitted scene
+ * (RC_ERR_NOT_COMMITTED), pose_count 0 or a missing buffer
+ * (RC_ERR_INVALID_ARGUMENT), capacity too small (RC_ERR_CAPACITY), a NaN/inf
+ * pose or a quaternion whose norm is not within 1e-3 of 1 (RC_ERR_NON_FINITE /
+ * RC_ERR_INVALID_ARGUMENT; near-unit ones are normalised). Runs on the context's
+ * threads; results are bit-identical for any thread count. No allocation. */
+RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
+                             const rc_pose *poses, uint32_t pose_count, const rc_results *results);
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* RANGECAST_H */

@@ -1,0 +1,55 @@
+/* The one internal interface every backend implements. Each backend file
+ * exports exactly one table; the core never tests which backends exist except
+ * through rc__backend_find. */
+#ifndef RC_BACKEND_BACKEND_H
+#define RC_BACKEND_BACKEND_H
+
+#include "core/context.h"
+#include "core/rmath.h"
+#include "scene/scene.h"
+#include "sensor/sensor.h"
+
+/* One simulate call, checked and ready. */
+typedef struct rc__sim_job {
+    const rc_scene *scene;
+    const rc_sensor *sensor;
+    const rc_pose *poses;      /* checked: finite, near-unit quaternions */
+    uint32_t pose_count;
+    uint32_t attributes;       /* RC_ATTR_* */
+    const rc_results *out;
+} rc__sim_job;
+
+typedef struct rc__backend {
+    uint32_t id;
+    const char *name;
+    /* 1 when compiled in and usable on this machine in principle. */
+    int (*available)(void);
+    /* Arena bytes init takes. */
+    size_t (*context_bytes)(const rc_context_desc *desc);
+    /* Exact peak arena bytes commit takes for a scene of these capacities. */
+    size_t (*scene_commit_bytes)(const rc_scene_desc *desc);
+    rc_status (*init)(rc_context *ctx, const rc_context_desc *desc);
+    void (*deinit)(rc_context *ctx);
+    rc_status (*scene_commit)(rc_scene *scene, rc_progress_fn progress, void *user);
+    void (*scene_release)(rc_scene *scene);
+    rc_status (*simulate)(rc_context *ctx, const rc__sim_job *job);
+    /* Adds backend_bytes / device_bytes. May be NULL. */
+    void (*memory_stats)(const rc_context *ctx, rc_memory_stats *stats);
+} rc__backend;
+
+/* NULL when that backend is not compiled in. AUTO resolves to the best one present. */
+const rc__backend *rc__backend_find(uint32_t id);
+
+extern const rc__backend rc__backend_bvh;
+
+/* Per-pose transform sensor -> map: pose * mount. */
+void rc__sensor_world_xform(const rc_sensor *sensor, const rc_pose *pose, rc__xformf *out);
+
+/* Writes every requested attribute of element k from a hit (or none).
+ * dir_s / org_s: the ray in the sensor frame (unit dir). hit->t is the range.
+ * n_world: unit geometric normal in the map frame (ignored when no hit).
+ * world: sensor -> map transform (to bring the normal into the sensor frame). */
+void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s,
+                      int found, const rc__hit *hit, const float n_world[3], const rc__xformf *world);
+
+#endif

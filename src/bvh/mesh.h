@@ -1,0 +1,59 @@
+/* A triangle mesh with its BVH, and single-ray nearest-hit traversal with the
+ * watertight ray/triangle test of Woop, Benthin and Wald (2013). */
+#ifndef RC_BVH_MESH_H
+#define RC_BVH_MESH_H
+
+#include "bvh/bvh.h"
+
+#include <stdint.h>
+
+typedef struct rc__mesh {
+    const float *vertices;     /* vertex i at vertices + i * stride (floats) */
+    const uint32_t *indices;   /* 3 per triangle */
+    uint32_t stride;           /* floats between vertices (>= 3) */
+    uint32_t vertex_count;
+    uint32_t triangle_count;
+    uint32_t reserved0;
+    rc__bvh bvh;               /* items are triangle indices */
+} rc__mesh;
+
+/* A ray prepared for traversal: origin, direction (any length, not zero),
+ * reciprocal direction for slab tests, and the shear constants of the
+ * watertight test. t is measured in units of |dir|. */
+typedef struct rc__ray {
+    float org[3];
+    float dir[3];
+    float inv_dir[3];
+    int kx, ky, kz;
+    float sx, sy, sz;
+} rc__ray;
+
+/* Nearest hit found so far. t = tmax before the search. */
+typedef struct rc__hit {
+    float t;
+    float u, v;        /* barycentrics of the hit on triangle prim */
+    uint32_t prim;     /* triangle index within its mesh */
+    uint32_t geom;     /* geometry id within its scene */
+    uint32_t inst;     /* instance id or RC_INVALID_ID */
+} rc__hit;
+
+void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3]);
+
+/* Item bounds of every triangle (for the builder). */
+void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);
+
+/* Searches the mesh for a hit with 0 < t < hit->t (or t == hit->t and a smaller
+ * (inst, geom, prim) key: the tie rule that makes coplanar overlaps pick the
+ * same triangle on every backend and thread count). Zero-area triangles never
+ * hit. On a closer hit, updates *hit (t, u, v, prim, and geom/inst from the
+ * arguments) and returns 1; else 0. */
+int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
+                       rc__hit *hit);
+
+/* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
+int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);
+
+/* Geometric normal of triangle prim (unnormalised, (v1-v0) x (v2-v0)). */
+void rc__mesh_triangle_normal(const rc__mesh *mesh, uint32_t prim, float n[3]);
+
+#endif

@@ -1,0 +1,51 @@
+/* The context object (internal view). Everything a context owns lives in its
+ * arena; scenes and sensors are linked so destroy can release backend state. */
+#ifndef RC_CORE_CONTEXT_H
+#define RC_CORE_CONTEXT_H
+
+#include "core/arena.h"
+#include "core/common.h"
+#include "core/threads.h"
+
+#define RC__MAGIC_CONTEXT 0x52434358u /* "RCCX" */
+#define RC__MAGIC_SCENE   0x52435343u /* "RCSC" */
+#define RC__MAGIC_SENSOR  0x52435345u /* "RCSE" */
+#define RC__MAGIC_DEAD    0xDEADDEADu
+
+#define RC__ERROR_TEXT 512
+
+struct rc__backend;
+struct rc_scene;
+struct rc_sensor;
+
+struct rc_context {
+    uint32_t magic;
+    uint32_t backend_id;            /* RC_BACKEND_BVH / _EMBREE / _VULKAN */
+    const struct rc__backend *backend;
+    void *backend_data;             /* the backend's own state, allocated by its init */
+    rc__arena arena;
+    void *owned_block;              /* the malloc'd block, NULL when it is the caller's */
+    rc__pool *pool;
+    uint32_t thread_count;
+    uint32_t reserved0;
+    rc_log_fn log;
+    void *log_user;
+    struct rc_scene *scenes;        /* singly linked, newest first */
+    struct rc_sensor *sensors;
+    rc_status last_status;
+    char last_error[RC__ERROR_TEXT];
+};
+
+/* Checks a context handle: RC_OK or RC_ERR_INVALID_HANDLE (no message can be
+ * stored when the handle itself is bad). */
+int rc__context_valid(const rc_context *ctx);
+
+/* Validates the common prefix of a descriptor: non-NULL, struct_size between
+ * min_size (the first released size) and sizeof. Writes a message naming
+ * `what` on failure. */
+rc_status rc__check_desc(rc_context *ctx, const void *desc, uint32_t min_size, uint32_t max_size,
+                         const char *what);
+/* Checks n reserved words are zero. */
+rc_status rc__check_reserved(rc_context *ctx, const uint32_t *words, size_t n, const char *what);
+
+#endif

@@ -1,0 +1,76 @@
+/* Scenes: meshes (geometries), instances of other scenes, and the two-level
+ * structure the built-in backend traverses (a top-level BVH over the scene's
+ * geometries and instances, one BVH per mesh). */
+#ifndef RC_SCENE_SCENE_H
+#define RC_SCENE_SCENE_H
+
+#include "bvh/mesh.h"
+#include "core/context.h"
+#include "core/rmath.h"
+
+typedef struct rc__geometry {
+    rc__mesh mesh;
+    void *bvh_block;          /* arena block holding mesh.bvh nodes and refs */
+    uint32_t flags;           /* RC_MESH_* */
+    uint32_t dirty;           /* 1: build, 2: refit at the next commit */
+} rc__geometry;
+
+typedef struct rc__instance {
+    const struct rc_scene *source;
+    rc_pose pose;
+    float scale[3];
+    uint32_t reserved0;
+    rc__xformf to_world;      /* source -> this scene, scale included (r = R * diag(s)) */
+    rc__xformf to_local;      /* inverse of to_world */
+    float normal_to_world[9]; /* R * diag(1/s): local normals -> scene normals (normalise after) */
+    rc__aabb bounds;          /* in this scene */
+} rc__instance;
+
+struct rc_scene {
+    uint32_t magic;
+    uint32_t committed;       /* 1 when the structure matches the content */
+    rc_context *ctx;
+    struct rc_scene *next;    /* the context's list */
+    rc_scene_desc desc;       /* capacities as created */
+    uint32_t geom_count;
+    uint32_t inst_count;
+    rc__geometry *geoms;      /* max_geometries */
+    rc__instance *insts;      /* max_instances */
+    float *copy_vertices;     /* max_vertices * 3 */
+    uint32_t *copy_indices;   /* max_copied_triangles * 3 */
+    uint64_t copied_vertices_used;
+    uint64_t copied_triangles_used;
+    uint64_t triangle_count;  /* over all own meshes */
+    uint32_t instanced_by;    /* number of instances (in other scenes) that use this scene */
+    uint32_t top_dirty;       /* top level needs rebuilding */
+    uint64_t version;         /* bumped at every successful commit */
+    uint64_t *source_versions;/* per instance: source->version seen at the last commit */
+    rc__bvh top;              /* items: geometries 0..geom_count-1, then instances */
+    void *top_block;
+    rc__aabb bounds;
+    void *backend_scene;      /* backend's own state (Embree scene, Vulkan buffers) */
+};
+
+int rc__scene_valid(const rc_scene *scene);
+
+/* Arena bytes of the scene object and its tables (at create). */
+size_t rc__scene_object_bytes(const rc_scene_desc *desc);
+
+/* Builds or refits the built-in two-level BVH of the scene: mesh BVHs that are
+ * dirty, then the top level. Used by the BVH backend and by the Vulkan backend
+ * (which uploads it). Exact peak arena use: rc__scene_bvh_commit_bytes. */
+rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *user);
+size_t rc__scene_bvh_commit_bytes(const rc_scene_desc *desc);
+void rc__scene_release_bvh(rc_scene *scene);
+
+/* 1 when every instance's source is committed at the version seen at our commit. */
+int rc__scene_up_to_date(const rc_scene *scene);
+
+/* Nearest hit in the scene along ray (scene coordinates), 0 < t < hit->t.
+ * Returns 1 when hit was updated. */
+int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit);
+
+/* Unit geometric normal of a hit, in the scene's frame. */
+void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3]);
+
+#endif
