@@ -253,12 +253,13 @@ typedef struct rc_scene_desc {
 RC_API rc_scene_desc rc_scene_desc_default(void);
 
 /* Exact arena bytes a scene with these capacities takes at its peak (create +
- * commit, build scratch included) on the context's backend: a context whose
- * arena has rc_context_memory_requirements + this (+ sensors) free can create,
- * fill and commit it; one byte less fails with RC_ERR_OUT_OF_MEMORY. The
- * figure holds when objects are created in order on a fresh context (no holes
- * left by destroyed objects). For the BVH backend only; other backends also
- * allocate internally. */
+ * commit, the commit's temporary build scratch included) on the context's
+ * backend. An arena of rc_context_memory_requirements + the sensors' + this
+ * can create, fill and commit it; when the sensors are created before the
+ * scene is committed, one byte less fails with RC_ERR_OUT_OF_MEMORY. With
+ * several scenes the sum is an upper bound (their scratch is not live at the
+ * same time). Holds on a fresh context (no holes left by destroyed objects).
+ * Embree and Vulkan also allocate outside the arena (rc_memory_stats). */
 RC_API rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_desc *desc,
                                               size_t *bytes);
 

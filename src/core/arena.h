@@ -35,6 +35,8 @@ void rc__arena_free(rc__arena *arena, void *ptr);
 /* Gives the tail of an allocation back (new_size <= its size). The block keeps
  * its address. */
 void rc__arena_shrink(rc__arena *arena, void *ptr, size_t new_size);
+/* Hands the whole block back to the caller (un-poisons it under ASan). */
+void rc__arena_fini(rc__arena *arena);
 /* Largest single allocation that would succeed now. */
 size_t rc__arena_largest_free(const rc__arena *arena);
 

@@ -1,0 +1,69 @@
+# Front door to the CMake build. `make demo` and `make test` install what they
+# need (tools/setup-deps.sh) on Debian 12, then build and run.
+BUILD ?= build
+JOBS ?= $(shell nproc 2>/dev/null || echo 2)
+CMAKE_FLAGS ?=
+CMAKE := cmake
+SAN_BUILD := $(BUILD)-asan
+
+.PHONY: all build deps-demo deps-test demo test test-fast asan ubsan sanitize valgrind install bench clean help
+
+all: build
+
+help:
+	@echo "make            build the library, the rangecast program and the tests"
+	@echo "make demo       install deps, build, simulate a VLP-16 and a D435 in the demo map (writes out/)"
+	@echo "make test       install deps, build, run all tests, then again under ASan+UBSan"
+	@echo "make test-fast  run the tests once (no sanitizer pass)"
+	@echo "make asan       tests under AddressSanitizer + UndefinedBehaviorSanitizer"
+	@echo "make valgrind   tests under valgrind memcheck (leaks are errors)"
+	@echo "make bench      rangecast bench on the standard workload (1M-triangle sphere)"
+	@echo "make install    install into PREFIX (default /usr/local)"
+
+deps-demo:
+	@sh tools/setup-deps.sh demo
+deps-test:
+	@sh tools/setup-deps.sh test
+
+$(BUILD)/CMakeCache.txt:
+	$(CMAKE) -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS)
+
+build: $(BUILD)/CMakeCache.txt
+	$(CMAKE) --build $(BUILD) -j $(JOBS)
+
+demo: deps-demo
+	$(CMAKE) -S . -B $(BUILD)-demo -DCMAKE_BUILD_TYPE=Release -DRANGECAST_BUILD_TESTS=OFF $(CMAKE_FLAGS)
+	$(CMAKE) --build $(BUILD)-demo -j $(JOBS) --target rangecast
+	./$(BUILD)-demo/tools/rangecast demo --out out
+
+test-fast: build
+	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+test: deps-test
+	$(MAKE) test-fast
+	$(MAKE) asan
+
+asan sanitize:
+	$(CMAKE) -S . -B $(SAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRANGECAST_SANITIZE=address,undefined \
+		-DRANGECAST_BUILD_SHARED=OFF $(CMAKE_FLAGS)
+	$(CMAKE) --build $(SAN_BUILD) -j $(JOBS)
+	cd $(SAN_BUILD) && ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+		RC_TEST_QUICK=1 ctest --output-on-failure -j $(JOBS)
+
+ubsan: asan
+
+valgrind: build
+	cd $(BUILD) && RC_TEST_QUICK=1 ctest --output-on-failure -E vulkan -T memcheck \
+		--overwrite MemoryCheckCommandOptions="--leak-check=full --error-exitcode=1"
+
+bench: build
+	./$(BUILD)/tools/rangecast bench --sensor vlp16 --backend bvh --threads 2 --repeat 3
+
+PREFIX ?= /usr/local
+install: build
+	$(CMAKE) --install $(BUILD) --prefix $(PREFIX)
+
+clean:
+	rm -rf $(BUILD) $(BUILD)-demo $(SAN_BUILD) out
+
+-include mk/*.mk

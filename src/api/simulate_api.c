@@ -1,0 +1,69 @@
+/* rc_simulate: every argument is checked before anything is written. */
+#include "backend/backend.h"
+
+#include <string.h>
+
+rc_results rc_results_default(void)
+{
+    rc_results r;
+    memset(&r, 0, sizeof r);
+    r.struct_size = (uint32_t)sizeof r;
+    return r;
+}
+
+static rc_status check_buffer(rc_context *ctx, uint32_t attributes, uint32_t bit, const void *buffer, const char *name)
+{
+    RC_RETURN_IF(ctx, (attributes & bit) && buffer == NULL, RC_ERR_INVALID_ARGUMENT,
+                 "results->%s is NULL but its attribute is requested", name);
+    return RC_OK;
+}
+
+rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
+                      uint32_t pose_count, const rc_results *results)
+{
+    rc__sim_job job;
+    uint64_t need;
+    uint32_t i, a;
+    if (!rc__context_valid(ctx)) return RC_ERR_INVALID_HANDLE;
+    rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, !rc__scene_valid(scene), RC_ERR_INVALID_HANDLE, "scene is not a valid scene handle");
+    RC_RETURN_IF(ctx, !rc__sensor_valid(sensor), RC_ERR_INVALID_HANDLE, "sensor is not a valid sensor handle");
+    RC_RETURN_IF(ctx, scene->ctx != ctx, RC_ERR_INVALID_ARGUMENT, "scene belongs to another context");
+    RC_RETURN_IF(ctx, sensor->ctx != ctx, RC_ERR_INVALID_ARGUMENT, "sensor belongs to another context");
+    RC_RETURN_IF(ctx, !rc__scene_up_to_date(scene), RC_ERR_NOT_COMMITTED,
+                 "scene is not committed (or it, or a scene it instances, changed since): call rc_scene_commit");
+    RC_RETURN_IF(ctx, poses == NULL, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
+    RC_RETURN_IF(ctx, pose_count == 0, RC_ERR_INVALID_ARGUMENT, "pose_count is 0");
+    RC_TRY(rc__check_desc(ctx, results, (uint32_t)sizeof *results, (uint32_t)sizeof *results, "results"));
+    RC_TRY(rc__check_reserved(ctx, results->reserved, 8, "results"));
+    a = results->attributes;
+    RC_RETURN_IF(ctx, a == 0, RC_ERR_INVALID_ARGUMENT, "results->attributes is 0: request at least one RC_ATTR_*");
+    RC_RETURN_IF(ctx, (a & ~RC_ATTR_ALL) != 0, RC_ERR_INVALID_ARGUMENT,
+                 "results->attributes has unknown bits 0x%x", (unsigned)(a & ~RC_ATTR_ALL));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_HITS, results->hits, "hits"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_RANGES, results->ranges, "ranges"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_POINTS, results->points, "points"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_NORMALS, results->normals, "normals"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_PRIM_IDS, results->prim_ids, "prim_ids"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_GEOM_IDS, results->geom_ids, "geom_ids"));
+    RC_TRY(check_buffer(ctx, a, RC_ATTR_INST_IDS, results->inst_ids, "inst_ids"));
+    need = (uint64_t)pose_count * sensor->rays;
+    RC_RETURN_IF(ctx, results->capacity < need, RC_ERR_CAPACITY,
+                 "results->capacity is %llu; %u poses x %u rays need %llu", (unsigned long long)results->capacity,
+                 (unsigned)pose_count, (unsigned)sensor->rays, (unsigned long long)need);
+    for (i = 0; i < pose_count; ++i) {
+        rc_status st = rc__pose_check(&poses[i]);
+        RC_RETURN_IF(ctx, st == RC_ERR_NON_FINITE, st, "poses[%u] has a NaN or infinite value", (unsigned)i);
+        RC_RETURN_IF(ctx, st != RC_OK, st,
+                     "poses[%u].orientation is not a unit quaternion (|q| = 1 within 1e-3 is normalised; "
+                     "farther off is rejected)",
+                     (unsigned)i);
+    }
+    job.scene = scene;
+    job.sensor = sensor;
+    job.poses = poses;
+    job.pose_count = pose_count;
+    job.attributes = a;
+    job.out = results;
+    return ctx->backend->simulate(ctx, &job);
+}

@@ -1,0 +1,75 @@
+/* Turning one ray's nearest hit into the caller's attributes (REP 117), shared
+ * by every CPU backend so they agree to the bit on what they write. */
+#include "backend/backend.h"
+
+#include <math.h>
+#include <string.h>
+
+void rc__sensor_world_xform(const rc_sensor *sensor, const rc_pose *pose, rc__xformf *out)
+{
+    rc__xform base, world;
+    rc__xform_from_pose(pose, &base);
+    rc__xform_mul(&base, &sensor->mount_xform, &world);
+    rc__xform_to_float(&world, out);
+}
+
+void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s, int found,
+                      const rc__hit *hit, const float n_world_in[3], const rc__xformf *world)
+{
+    const rc_results *out = job->out;
+    const uint32_t attr = job->attributes;
+    const rc_sensor *sensor = job->sensor;
+    int valid = found && hit->t >= sensor->range_min && hit->t <= sensor->range_max;
+    float range;
+
+    if (valid)
+        range = hit->t;
+    else if (found && hit->t < sensor->range_min)
+        range = -INFINITY;
+    else
+        range = INFINITY;
+
+    if (attr & RC_ATTR_HITS) out->hits[k] = (uint8_t)valid;
+    if (attr & RC_ATTR_RANGES) out->ranges[k] = range;
+    if (attr & RC_ATTR_POINTS) {
+        float *p = out->points + k * 3u;
+        if (valid) {
+            p[0] = dir_s[0] * range;
+            p[1] = dir_s[1] * range;
+            p[2] = dir_s[2] * range;
+            if (org_s) {
+                p[0] += org_s[0];
+                p[1] += org_s[1];
+                p[2] += org_s[2];
+            }
+        } else {
+            p[0] = p[1] = p[2] = NAN;
+        }
+    }
+    if (attr & RC_ATTR_NORMALS) {
+        float *n = out->normals + k * 3u;
+        if (valid) {
+            float nw[3], ns[3];
+            if (n_world_in) {
+                memcpy(nw, n_world_in, sizeof nw);
+            } else {
+                rc__scene_hit_normal(job->scene, hit, nw);
+            }
+            rc__rot_apply_transposed_f(world->r, nw, ns);
+            /* face the sensor: against the ray */
+            if (rc__dot3f(ns, dir_s) > 0.0f) {
+                ns[0] = -ns[0];
+                ns[1] = -ns[1];
+                ns[2] = -ns[2];
+            }
+            n[0] = ns[0];
+            n[1] = ns[1];
+            n[2] = ns[2];
+        } else {
+            n[0] = n[1] = n[2] = NAN;
+        }
+    }
+    if (attr & RC_ATTR_PRIM_IDS) out->prim_ids[k] = valid ? hit->prim : RC_INVALID_ID;
+    if (attr & RC_ATTR_GEOM_IDS) out->geom_ids[k] = valid ? hit->geom : RC_INVALID_ID;
+    if (attr & RC_ATTR_INST_IDS) out->inst_ids[k] = valid ? hit->inst : RC_INVALID_ID;
+}

@@ -1,0 +1,103 @@
+/* Nearest-hit search through a scene's two levels: the top BVH over geometries
+ * and instances, then each mesh's BVH (instances in their own frame). */
+#include "scene/scene.h"
+
+#include <math.h>
+
+/* Slab test against a top-level node. Top-level boxes are few, so this is not
+ * the hot loop; NaN from 0 * inf is avoided by the ordered min/max below. */
+static int box_hit(const rc__ray *r, const float bmin[3], const float bmax[3], float tmax, float *tnear)
+{
+    float t0 = 0.0f, t1 = tmax;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float a = (bmin[k] - r->org[k]) * r->inv_dir[k];
+        float b = (bmax[k] - r->org[k]) * r->inv_dir[k];
+        float lo = a < b ? a : b, hi = a < b ? b : a;
+        if (a != a || b != b) { /* 0 * inf: origin on the slab plane with a parallel ray */
+            if (r->org[k] < bmin[k] || r->org[k] > bmax[k]) return 0;
+            continue;
+        }
+        if (lo > t0) t0 = lo;
+        if (hi < t1) t1 = hi;
+    }
+    /* a small relative margin keeps boxes of flat meshes from being missed */
+    *tnear = t0;
+    return t0 <= t1 * 1.0000002f;
+}
+
+static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc__ray *ray, rc__hit *hit)
+{
+    const rc_scene *src = in->source;
+    rc__ray local;
+    float o[3], d[3];
+    uint32_t g;
+    int found = 0;
+    rc__rot_apply_f(in->to_local.r, ray->org, o);
+    o[0] += in->to_local.t[0];
+    o[1] += in->to_local.t[1];
+    o[2] += in->to_local.t[2];
+    rc__rot_apply_f(in->to_local.r, ray->dir, d);
+    rc__ray_prepare(&local, o, d);
+    /* Sources hold a few meshes: test each mesh's root through its own BVH. */
+    for (g = 0; g < src->geom_count; ++g) found |= rc__mesh_intersect(&src->geoms[g].mesh, &local, g, inst_id, hit);
+    return found;
+}
+
+int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
+{
+    uint32_t stack[64];
+    uint32_t sp = 0, ni = 0;
+    int found = 0;
+    const rc__bvh *top = &scene->top;
+
+    if (scene->geom_count == 1 && scene->inst_count == 0)
+        return rc__mesh_intersect(&scene->geoms[0].mesh, ray, 0, RC_INVALID_ID, hit);
+    if (top->node_count == 0) return 0;
+    for (;;) {
+        const rc__bvh_node *n = &top->nodes[ni];
+        float tn;
+        if (box_hit(ray, n->bmin, n->bmax, hit->t, &tn)) {
+            if (n->count == 0) {
+                if (sp + 1 < 64) stack[sp++] = n->index + 1;
+                ni = n->index;
+                continue;
+            } else {
+                uint32_t k;
+                for (k = 0; k < n->count; ++k) {
+                    uint32_t item = top->refs[n->index + k];
+                    if (item < scene->geom_count)
+                        found |= rc__mesh_intersect(&scene->geoms[item].mesh, ray, item, RC_INVALID_ID, hit);
+                    else
+                        found |= instance_intersect(&scene->insts[item - scene->geom_count],
+                                                    item - scene->geom_count, ray, hit);
+                }
+            }
+        }
+        if (sp == 0) break;
+        ni = stack[--sp];
+    }
+    return found;
+}
+
+void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3])
+{
+    float local[3];
+    double len;
+    if (hit->inst == RC_INVALID_ID) {
+        rc__mesh_triangle_normal(&scene->geoms[hit->geom].mesh, hit->prim, local);
+        n[0] = local[0];
+        n[1] = local[1];
+        n[2] = local[2];
+    } else {
+        const rc__instance *in = &scene->insts[hit->inst];
+        rc__mesh_triangle_normal(&in->source->geoms[hit->geom].mesh, hit->prim, local);
+        rc__rot_apply_f(in->normal_to_world, local, n);
+    }
+    len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    if (len > 0.0) {
+        n[0] = (float)(n[0] / len);
+        n[1] = (float)(n[1] / len);
+        n[2] = (float)(n[2] / len);
+    }
+}
