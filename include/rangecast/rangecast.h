@@ -471,8 +471,11 @@ RC_API uint32_t rc_preset_model(uint32_t preset);
  * otherwise). The caller may change fields before creating. Thread-safe. */
 RC_API rc_status rc_preset_spherical(uint32_t preset, rc_spherical_desc *desc);
 RC_API rc_status rc_preset_pinhole(uint32_t preset, rc_pinhole_desc *desc);
-/* Writes the preset's 3 * count floats of directions (count = the preset's ray
- * count, given by *count on return when directions is NULL). */
+/* O1Dn presets: fills desc and writes the preset's directions (3 floats a
+ * ray). With directions NULL, only *count is set to the preset's ray count.
+ * Otherwise *count is the capacity of directions in rays on input
+ * (RC_ERR_CAPACITY, nothing written, when too small) and the ray count on
+ * return. Thread-safe. */
 RC_API rc_status rc_preset_rays(uint32_t preset, rc_rays_desc *desc, float *directions, uint32_t *count);
 /* Creates any preset directly (the O1Dn ones generate their directions). */
 RC_API rc_status rc_sensor_create_preset(rc_context *ctx, uint32_t preset, rc_sensor **out);

@@ -46,7 +46,7 @@ static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc
 
 int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
 {
-    uint32_t stack[64];
+    uint32_t stack[RC__BVH_MAX_DEPTH + 1];
     uint32_t sp = 0, ni = 0;
     int found = 0;
     const rc__bvh *top = &scene->top;
@@ -59,7 +59,7 @@ int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
         float tn;
         if (box_hit(ray, n->bmin, n->bmax, hit->t, &tn)) {
             if (n->count == 0) {
-                if (sp + 1 < 64) stack[sp++] = n->index + 1;
+                stack[sp++] = n->index + 1; /* depth is capped by the builder */
                 ni = n->index;
                 continue;
             } else {
