@@ -1,0 +1,163 @@
+#include "poses.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define RCU_PI 3.14159265358979323846
+
+static uint64_t splitmix64(uint64_t *x)
+{
+    uint64_t z = (*x += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+void rcu_rng_seed(rcu_rng *rng, uint64_t seed)
+{
+    int i;
+    for (i = 0; i < 4; i++) rng->s[i] = splitmix64(&seed);
+}
+
+static uint64_t rotl(uint64_t x, int k)
+{
+    return (x << k) | (x >> (64 - k));
+}
+
+uint64_t rcu_rng_next(rcu_rng *rng)
+{
+    uint64_t *s = rng->s;
+    uint64_t result = rotl(s[1] * 5u, 7) * 9u;
+    uint64_t t = s[1] << 17;
+    s[2] ^= s[0];
+    s[3] ^= s[1];
+    s[1] ^= s[2];
+    s[0] ^= s[3];
+    s[2] ^= t;
+    s[3] = rotl(s[3], 45);
+    return result;
+}
+
+double rcu_rng_uniform(rcu_rng *rng)
+{
+    return (double)(rcu_rng_next(rng) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+void rcu_poses_random(uint32_t count, float radius, uint64_t seed, rc_pose *out)
+{
+    rcu_poses_random_about(count, radius, seed, NULL, out);
+}
+
+void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const float center[3],
+                            rc_pose *out)
+{
+    rcu_rng rng;
+    uint32_t i;
+    rcu_rng_seed(&rng, seed);
+    for (i = 0; i < count; i++) {
+        double x, y, z, u1, u2, u3, a, b;
+        /* rejection sampling in the cube: uniform in the ball, no transcendental
+         * functions, so the positions are bit-identical everywhere */
+        do {
+            x = 2.0 * rcu_rng_uniform(&rng) - 1.0;
+            y = 2.0 * rcu_rng_uniform(&rng) - 1.0;
+            z = 2.0 * rcu_rng_uniform(&rng) - 1.0;
+        } while (x * x + y * y + z * z > 1.0);
+        out[i].position[0] = (float)(x * radius + (center ? center[0] : 0.0f));
+        out[i].position[1] = (float)(y * radius + (center ? center[1] : 0.0f));
+        out[i].position[2] = (float)(z * radius + (center ? center[2] : 0.0f));
+        /* Shoemake 1992, "Uniform random rotations" */
+        u1 = rcu_rng_uniform(&rng);
+        u2 = rcu_rng_uniform(&rng);
+        u3 = rcu_rng_uniform(&rng);
+        a = sqrt(1.0 - u1);
+        b = sqrt(u1);
+        out[i].orientation[0] = (float)(a * sin(2.0 * RCU_PI * u2));
+        out[i].orientation[1] = (float)(a * cos(2.0 * RCU_PI * u2));
+        out[i].orientation[2] = (float)(b * sin(2.0 * RCU_PI * u3));
+        out[i].orientation[3] = (float)(b * cos(2.0 * RCU_PI * u3));
+    }
+}
+
+int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count)
+{
+    unsigned char *data;
+    size_t size, n, i;
+    rc_pose *poses;
+    if (rcu_read_file(path, &data, &size) != 0) return -1;
+    if (size == 0) {
+        free(data);
+        return rcu_fail("%s: empty pose file (expected 28 bytes a pose: 7 little-endian float32 "
+                        "x y z qx qy qz qw)", path);
+    }
+    if (size % RCU_POSE_FILE_BYTES != 0) {
+        free(data);
+        return rcu_fail("%s: size %zu bytes is not a multiple of 28 (7 little-endian float32 "
+                        "x y z qx qy qz qw per pose); %zu bytes left over",
+                        path, size, size % RCU_POSE_FILE_BYTES);
+    }
+    n = size / RCU_POSE_FILE_BYTES;
+    if (n > UINT32_MAX) {
+        free(data);
+        return rcu_fail("%s: too many poses (%zu)", path, n);
+    }
+    poses = (rc_pose *)malloc(n * sizeof *poses);
+    if (!poses) {
+        free(data);
+        return rcu_fail("%s: out of memory for %zu poses", path, n);
+    }
+    for (i = 0; i < n; i++) {
+        const unsigned char *p = data + i * RCU_POSE_FILE_BYTES;
+        double norm2 = 0.0;
+        int k;
+        for (k = 0; k < 3; k++) poses[i].position[k] = rcu_load_f32le(p + 4 * k);
+        for (k = 0; k < 4; k++) {
+            poses[i].orientation[k] = rcu_load_f32le(p + 12 + 4 * k);
+            norm2 += (double)poses[i].orientation[k] * poses[i].orientation[k];
+        }
+        for (k = 0; k < 3; k++)
+            if (!isfinite(poses[i].position[k])) break;
+        if (k < 3 || !isfinite(norm2)) {
+            free(data);
+            free(poses);
+            return rcu_fail("%s: pose %zu (byte offset %zu) has a NaN or infinite value", path, i,
+                            i * RCU_POSE_FILE_BYTES);
+        }
+        if (fabs(sqrt(norm2) - 1.0) > 1e-3) {
+            rcu_fail("%s: pose %zu (byte offset %zu): quaternion (%g, %g, %g, %g) has norm %g, "
+                     "not 1 (is the file x y z qx qy qz qw float32 little-endian?)",
+                     path, i, i * RCU_POSE_FILE_BYTES, (double)poses[i].orientation[0],
+                     (double)poses[i].orientation[1], (double)poses[i].orientation[2],
+                     (double)poses[i].orientation[3], sqrt(norm2));
+            free(data);
+            free(poses);
+            return -1;
+        }
+    }
+    free(data);
+    *out = poses;
+    *count = (uint32_t)n;
+    return 0;
+}
+
+int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count)
+{
+    FILE *f = fopen(path, "wb");
+    uint32_t i;
+    if (!f) return rcu_fail("%s: %s", path, strerror(errno));
+    for (i = 0; i < count; i++) {
+        unsigned char rec[RCU_POSE_FILE_BYTES];
+        int k;
+        for (k = 0; k < 3; k++) rcu_store_f32le(rec + 4 * k, poses[i].position[k]);
+        for (k = 0; k < 4; k++) rcu_store_f32le(rec + 12 + 4 * k, poses[i].orientation[k]);
+        if (fwrite(rec, 1, sizeof rec, f) != sizeof rec) {
+            fclose(f);
+            return rcu_fail("%s: write error", path);
+        }
+    }
+    if (fclose(f) != 0) return rcu_fail("%s: write error", path);
+    return 0;
+}

@@ -1,0 +1,42 @@
+/* rcutil: raw pose files and the standard random poses.
+ *
+ * A raw pose file is a sequence of little-endian float32, 7 per pose:
+ * x y z qx qy qz qw (base-to-map), 28 bytes a pose, no header. It maps onto an
+ * array of rc_pose exactly. */
+#ifndef RCU_POSES_H
+#define RCU_POSES_H
+
+#include <stdint.h>
+
+#include "rangecast/rangecast.h"
+#include "util.h"
+
+#define RCU_POSE_FILE_BYTES 28u
+
+/* Reads a pose file into a malloc'd array (free() it). Fails (-1, message in
+ * rcu_last_error) on an empty file, a size that is not a multiple of 28 bytes,
+ * or a non-finite value or a quaternion far from unit length (naming the pose). */
+int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count);
+
+/* Writes count poses. */
+int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count);
+
+/* count poses with positions uniform in the ball of the given radius about
+ * the origin and orientations uniformly random unit quaternions (Shoemake),
+ * from xoshiro256** seeded by splitmix64(seed): the same seed gives the same
+ * poses on every platform (positions by rejection sampling, no libm). */
+void rcu_poses_random(uint32_t count, float radius, uint64_t seed, rc_pose *out);
+/* The same about center (NULL = origin). */
+void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const float center[3],
+                            rc_pose *out);
+
+/* The deterministic generator behind rcu_poses_random, for tests. */
+typedef struct rcu_rng {
+    uint64_t s[4];
+} rcu_rng;
+void rcu_rng_seed(rcu_rng *rng, uint64_t seed);
+uint64_t rcu_rng_next(rcu_rng *rng);
+/* Uniform in [0, 1) with 53 random bits. */
+double rcu_rng_uniform(rcu_rng *rng);
+
+#endif

@@ -1,0 +1,289 @@
+/* rangecast simulate: a sensor at one or many poses in a mesh map -> a point
+ * cloud of every return (and a range image of the first scan). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cloud.h"
+#include "mesh_load.h"
+#include "poses.h"
+#include "range_image.h"
+#include "reference.h"
+#include "tool.h"
+#include "util.h"
+
+#define SIM_CHUNK_BYTES ((size_t)128 << 20) /* result buffers per rc_simulate call */
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "Usage: rangecast simulate --map FILE (--poses FILE | --pose x,y,z,qx,qy,qz,qw) -o OUT [options]\n"
+        "\n"
+        "Simulates a sensor at each pose (base-to-map) and writes every valid return\n"
+        "as one point cloud.\n"
+        "\n"
+        "Options:\n"
+        "  --map FILE          mesh map (%s)\n"
+        "  --poses FILE        raw poses: float32 LE x y z qx qy qz qw per pose\n"
+        "  --pose P            one pose, x,y,z,qx,qy,qz,qw (quaternion optional: x,y,z)\n"
+        "  --sensor NAME       vlp16 (default), vlp16-360, os1-64, d435, livox-mid40\n"
+        "  --backend B         auto (default), bvh, embree, vulkan\n"
+        "  --threads N         worker threads, 0 = all CPUs (default)\n"
+        "  -o, --output OUT    .ply or .pcd (binary unless --ascii)\n"
+        "  --ascii             write ascii PLY/PCD\n"
+        "  --frame F           sensor (default: each scan in its own sensor frame) or map\n"
+        "  --fields LIST       extra per-point fields, comma-separated: range, intensity, ring\n"
+        "  --image OUT.png     range image of the first scan (colour; inf black, -inf white)\n"
+        "  --image-mode M      color (default) or gray16 (millimetres, 0 = no return)\n"
+        "  -h, --help          this text\n",
+        rcp_mesh_formats());
+}
+
+typedef struct sim_args {
+    const char *map, *poses_path, *out, *image, *sensor_name;
+    int have_pose, ascii, map_frame;
+    rc_pose pose;
+    uint32_t preset, backend, threads, fields, image_mode;
+} sim_args;
+
+static int parse_fields(const char *s, uint32_t *fields)
+{
+    *fields = 0;
+    while (*s) {
+        size_t n = strcspn(s, ",");
+        if (n == 5 && strncmp(s, "range", 5) == 0) *fields |= RCU_CLOUD_RANGE;
+        else if (n == 9 && strncmp(s, "intensity", 9) == 0) *fields |= RCU_CLOUD_INTENSITY;
+        else if (n == 4 && strncmp(s, "ring", 4) == 0) *fields |= RCU_CLOUD_RING;
+        else if (n != 0) return -1;
+        s += n;
+        if (*s == ',') s++;
+    }
+    return 0;
+}
+
+static int parse_args(int argc, char **argv, sim_args *a)
+{
+    const char *cmd = "simulate";
+    int i, r;
+    memset(a, 0, sizeof *a);
+    a->sensor_name = "vlp16";
+    for (i = 1; i < argc; i++) {
+        const char *v = NULL;
+        if (rcp_is_help(argv[i])) {
+            usage(stdout);
+            exit(RCP_EXIT_OK);
+        }
+#define OPT(name) ((r = rcp_opt(argc, argv, &i, name, &v)) != 0)
+        if (OPT("--map")) { if (r < 0) return -1; a->map = v; }
+        else if (OPT("--poses")) { if (r < 0) return -1; a->poses_path = v; }
+        else if (OPT("--pose")) {
+            float p[7];
+            if (r < 0) return -1;
+            if (rcp_parse_floats(v, p, 7) == 0) {
+                memcpy(a->pose.position, p, sizeof a->pose.position);
+                memcpy(a->pose.orientation, p + 3, sizeof a->pose.orientation);
+            } else if (rcp_parse_floats(v, p, 3) == 0) {
+                a->pose = rc_pose_identity();
+                memcpy(a->pose.position, p, sizeof a->pose.position);
+            } else {
+                return rcp_usage_error(cmd, "--pose: expected x,y,z,qx,qy,qz,qw or x,y,z, got '%s'", v), -1;
+            }
+            {
+                double q2 = 0.0;
+                int k;
+                for (k = 0; k < 4; k++) q2 += (double)a->pose.orientation[k] * a->pose.orientation[k];
+                if (fabs(sqrt(q2) - 1.0) > 1e-3)
+                    return rcp_usage_error(cmd, "--pose: the quaternion (%g, %g, %g, %g) has norm %g, not 1",
+                                           (double)a->pose.orientation[0], (double)a->pose.orientation[1],
+                                           (double)a->pose.orientation[2], (double)a->pose.orientation[3],
+                                           sqrt(q2)), -1;
+            }
+            a->have_pose = 1;
+        } else if (OPT("--sensor")) {
+            if (r < 0 || rcp_parse_sensor(cmd, v, &a->preset) != 0) return -1;
+            a->sensor_name = v;
+        } else if (OPT("--backend")) {
+            if (r < 0 || rcp_parse_backend(cmd, v, &a->backend) != 0) return -1;
+        } else if (OPT("--threads")) {
+            if (r < 0) return -1;
+            if (rcp_parse_u32(v, &a->threads) != 0 || a->threads > RC_MAX_THREADS)
+                return rcp_usage_error(cmd, "--threads: expected 0..%u, got '%s'", RC_MAX_THREADS, v), -1;
+        } else if (OPT("-o") || (r == 0 && OPT("--output"))) {
+            if (r < 0) return -1;
+            a->out = v;
+        } else if (strcmp(argv[i], "--ascii") == 0) {
+            a->ascii = 1;
+        } else if (OPT("--frame")) {
+            if (r < 0) return -1;
+            if (strcmp(v, "map") == 0) a->map_frame = 1;
+            else if (strcmp(v, "sensor") == 0) a->map_frame = 0;
+            else return rcp_usage_error(cmd, "--frame: expected sensor or map, got '%s'", v), -1;
+        } else if (OPT("--fields")) {
+            if (r < 0) return -1;
+            if (parse_fields(v, &a->fields) != 0)
+                return rcp_usage_error(cmd, "--fields: expected a list of range, intensity, ring; got '%s'", v), -1;
+        } else if (OPT("--image")) {
+            if (r < 0) return -1;
+            a->image = v;
+        } else if (OPT("--image-mode")) {
+            if (r < 0) return -1;
+            if (strcmp(v, "color") == 0 || strcmp(v, "colour") == 0) a->image_mode = RCP_IMAGE_COLOR;
+            else if (strcmp(v, "gray16") == 0 || strcmp(v, "grey16") == 0) a->image_mode = RCP_IMAGE_GRAY16;
+            else return rcp_usage_error(cmd, "--image-mode: expected color or gray16, got '%s'", v), -1;
+        } else {
+            return rcp_usage_error(cmd, "unknown argument '%s'", argv[i]), -1;
+        }
+#undef OPT
+    }
+    if (!a->map) return rcp_usage_error(cmd, "--map FILE is required"), -1;
+    if (!a->poses_path && !a->have_pose) return rcp_usage_error(cmd, "give --poses FILE or --pose x,y,z,qx,qy,qz,qw"), -1;
+    if (a->poses_path && a->have_pose) return rcp_usage_error(cmd, "give either --poses or --pose, not both"), -1;
+    if (!a->out) return rcp_usage_error(cmd, "-o OUT.ply|OUT.pcd is required"), -1;
+    {
+        char ext[8];
+        rcu_path_extension(a->out, ext, sizeof ext);
+        if (strcmp(ext, "ply") != 0 && strcmp(ext, "pcd") != 0)
+            return rcp_usage_error(cmd, "-o %s: the point cloud must be .ply or .pcd", a->out), -1;
+    }
+    if (a->preset == 0) a->preset = rc_preset_from_name(a->sensor_name);
+    return 0;
+}
+
+/* Writes the range image of one scan; 0 or RCP_EXIT_FAIL (message printed). */
+static int write_image(const char *cmd, const char *path, uint32_t preset, const rc_sensor_info *si,
+                       const float *ranges, uint32_t mode)
+{
+    rcp_image_options io;
+    char written[4096];
+    int st;
+    rcp_image_options_for(si->model, si->rows, si->columns, &io);
+    io.mode = mode;
+    if (si->model == RC_SENSOR_O1DN && si->rows <= 1 && mode == RCP_IMAGE_COLOR) {
+        rcu_preset_rays ref;
+        if (rcu_preset_rays_f64(preset, &ref) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
+        st = rcp_scatter_image_write(path, ranges, ref.dirs, ref.rays, 640, &io, written, sizeof written);
+        rcu_preset_rays_free(&ref);
+    } else {
+        st = rcp_range_image_write(path, ranges, si->rows, si->columns, &io, written, sizeof written);
+    }
+    if (st != 0) return rcp_fail(cmd, "%s", rcu_last_error());
+    if (!rcp_range_image_has_png())
+        fprintf(stderr, "rangecast %s: built without libpng: wrote %s instead of %s\n", cmd, written, path);
+    return 0;
+}
+
+int rcp_cmd_simulate(int argc, char **argv)
+{
+    const char *cmd = "simulate";
+    sim_args a;
+    rcu_mesh mesh;
+    rc_pose *poses = NULL;
+    uint32_t pose_count = 0, rays, chunk, p;
+    rcp_world w;
+    rc_sensor_info si = rc_sensor_info_default();
+    rcu_cloud cloud;
+    rcu_preset_rays ref;
+    float *points = NULL, *ranges = NULL, *normals = NULL;
+    uint8_t *hits = NULL;
+    double t_sim = 0.0;
+    int rc = RCP_EXIT_FAIL;
+    char n1[32], n2[32];
+
+    if (parse_args(argc, argv, &a) != 0) return RCP_EXIT_USAGE;
+    memset(&w, 0, sizeof w);
+    memset(&ref, 0, sizeof ref);
+    rcu_cloud_init(&cloud, a.fields);
+    if (rcp_mesh_load(a.map, &mesh) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
+    if (a.poses_path) {
+        if (rcu_poses_read(a.poses_path, &poses, &pose_count) != 0) {
+            rcp_fail(cmd, "%s", rcu_last_error());
+            goto done;
+        }
+    } else {
+        poses = (rc_pose *)malloc(sizeof *poses);
+        if (!poses) goto done;
+        poses[0] = a.pose;
+        pose_count = 1;
+    }
+    if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) goto done;
+    rc_sensor_get_info(w.sensors[0], &si);
+    rays = si.rays_per_scan;
+    if (rcu_preset_rays_f64(a.preset, &ref) != 0) {
+        rcp_fail(cmd, "%s", rcu_last_error());
+        goto done;
+    }
+
+    chunk = (uint32_t)(SIM_CHUNK_BYTES / ((size_t)rays * 29u));
+    if (chunk == 0) chunk = 1;
+    if (chunk > pose_count) chunk = pose_count;
+    points = (float *)malloc((size_t)chunk * rays * 3u * sizeof(float));
+    ranges = (float *)malloc((size_t)chunk * rays * sizeof(float));
+    hits = (uint8_t *)malloc((size_t)chunk * rays);
+    if (a.fields & RCU_CLOUD_INTENSITY) normals = (float *)malloc((size_t)chunk * rays * 3u * sizeof(float));
+    if (!points || !ranges || !hits || ((a.fields & RCU_CLOUD_INTENSITY) && !normals)) {
+        rcp_fail(cmd, "out of memory for %u scans of results", chunk);
+        goto done;
+    }
+    for (p = 0; p < pose_count; p += chunk) {
+        uint32_t n = pose_count - p < chunk ? pose_count - p : chunk;
+        rc_results res = rc_results_default();
+        rcu_scan_view view;
+        rc_status st;
+        double t0;
+        res.attributes = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_POINTS | (normals ? RC_ATTR_NORMALS : 0u);
+        res.hits = hits;
+        res.ranges = ranges;
+        res.points = points;
+        res.normals = normals;
+        res.capacity = (uint64_t)n * rays;
+        t0 = rcu_now();
+        if ((st = rc_simulate(w.ctx, w.scene, w.sensors[0], poses + p, n, &res)) != RC_OK) {
+            rcp_lib_error(cmd, w.ctx, "rc_simulate", st);
+            goto done;
+        }
+        t_sim += rcu_now() - t0;
+        memset(&view, 0, sizeof view);
+        view.points = points;
+        view.hits = hits;
+        view.ranges = ranges;
+        view.normals = normals;
+        view.rays_per_scan = rays;
+        view.columns = si.columns;
+        view.pose_count = n;
+        view.poses = a.map_frame ? poses + p : NULL;
+        view.sensor_to_base = &ref.mount;
+        if (rcu_cloud_append(&cloud, &view) != 0) {
+            rcp_fail(cmd, "%s", rcu_last_error());
+            goto done;
+        }
+        if (p == 0 && a.image && write_image(cmd, a.image, a.preset, &si, ranges, a.image_mode) != 0)
+            goto done;
+    }
+    if (rcu_cloud_write(a.out, &cloud, a.ascii) != 0) {
+        rcp_fail(cmd, "%s", rcu_last_error());
+        goto done;
+    }
+    if (pose_count > 1 && !a.map_frame)
+        fprintf(stderr, "rangecast simulate: note: %u scans written each in its own sensor frame "
+                        "(--frame map places them in the map)\n", pose_count);
+    printf("%s: %u scan%s x %s rays, %s returns (%.1f%%), simulated in %.3f s (%.0f scans/s, %s, %u threads) -> %s",
+           a.sensor_name, pose_count, pose_count == 1 ? "" : "s", rcp_thousands(rays, n1, sizeof n1),
+           rcp_thousands(cloud.count, n2, sizeof n2),
+           100.0 * (double)cloud.count / ((double)pose_count * rays), t_sim,
+           t_sim > 0 ? pose_count / t_sim : 0.0, rc_backend_name(w.backend), w.threads, a.out);
+    if (a.image) printf(", %s", a.image);
+    printf("\n");
+    rc = RCP_EXIT_OK;
+done:
+    rcp_world_destroy(&w);
+    rcu_preset_rays_free(&ref);
+    rcu_cloud_free(&cloud);
+    free(points);
+    free(ranges);
+    free(hits);
+    free(normals);
+    free(poses);
+    rcu_mesh_free(&mesh);
+    return rc;
+}

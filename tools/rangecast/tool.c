@@ -1,0 +1,338 @@
+#include "tool.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "util.h"
+
+static void vmessage(const char *cmd, const char *fmt, va_list ap)
+{
+    fprintf(stderr, "rangecast%s%s: ", cmd ? " " : "", cmd ? cmd : "");
+    vfprintf(stderr, fmt, ap);
+    fputc('\n', stderr);
+}
+
+int rcp_usage_error(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vmessage(cmd, fmt, ap);
+    va_end(ap);
+    if (cmd) fprintf(stderr, "Try 'rangecast %s --help'.\n", cmd);
+    else fprintf(stderr, "Try 'rangecast help'.\n");
+    return RCP_EXIT_USAGE;
+}
+
+int rcp_fail(const char *cmd, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vmessage(cmd, fmt, ap);
+    va_end(ap);
+    return RCP_EXIT_FAIL;
+}
+
+int rcp_lib_error(const char *cmd, const rc_context *ctx, const char *call, rc_status st)
+{
+    const char *detail = ctx ? rc_context_last_error(ctx) : "";
+    return rcp_fail(cmd, "%s failed: %s%s%s", call, rc_status_string(st), detail && *detail ? ": " : "",
+                    detail ? detail : "");
+}
+
+int rcp_is_help(const char *arg)
+{
+    return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
+}
+
+int rcp_opt(int argc, char **argv, int *i, const char *name, const char **value)
+{
+    const char *a = argv[*i];
+    size_t n = strlen(name);
+    if (strncmp(a, name, n) != 0) return 0;
+    if (a[n] == '=') {
+        *value = a + n + 1;
+        return 1;
+    }
+    if (a[n] != 0) return 0;
+    if (*i + 1 >= argc) {
+        fprintf(stderr, "rangecast %s: option %s needs a value\nTry 'rangecast %s --help'.\n", argv[0],
+                name, argv[0]);
+        return -1;
+    }
+    *value = argv[++*i];
+    return 1;
+}
+
+int rcp_parse_u32(const char *s, uint32_t *out)
+{
+    uint64_t v;
+    if (rcp_parse_count(s, &v) != 0 || v > UINT32_MAX) return -1;
+    *out = (uint32_t)v;
+    return 0;
+}
+
+int rcp_parse_count(const char *s, uint64_t *out)
+{
+    char *end;
+    double v, mul = 1.0;
+    if (!s || !*s || *s == '-' || *s == '+') return -1;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || errno) return -1;
+    if (*end == 'k' || *end == 'K') mul = 1e3, end++;
+    else if (*end == 'M' || *end == 'm') mul = 1e6, end++;
+    else if (*end == 'G' || *end == 'g') mul = 1e9, end++;
+    if (*end) return -1;
+    v *= mul;
+    if (!(v >= 0.0) || v > 1.8e19 || v != floor(v)) return -1;
+    *out = (uint64_t)v;
+    return 0;
+}
+
+int rcp_parse_float(const char *s, float *out)
+{
+    char *end;
+    double v;
+    if (!s || !*s) return -1;
+    errno = 0;
+    v = strtod(s, &end);
+    if (end == s || *end || errno || !isfinite(v)) return -1;
+    *out = (float)v;
+    return 0;
+}
+
+int rcp_parse_floats(const char *s, float *out, int n)
+{
+    int k;
+    for (k = 0; k < n; k++) {
+        char *end;
+        double v;
+        errno = 0;
+        v = strtod(s, &end);
+        if (end == s || errno || !isfinite(v)) return -1;
+        out[k] = (float)v;
+        s = end;
+        if (k + 1 < n) {
+            if (*s != ',') return -1;
+            s++;
+        }
+    }
+    return *s ? -1 : 0;
+}
+
+const char *rcp_available_backends(char *buf, size_t size)
+{
+    static const uint32_t all[] = {RC_BACKEND_BVH, RC_BACKEND_EMBREE, RC_BACKEND_VULKAN};
+    size_t k, used = 0;
+    buf[0] = 0;
+    for (k = 0; k < sizeof all / sizeof all[0]; k++) {
+        if (!rc_backend_available(all[k])) continue;
+        used += (size_t)snprintf(buf + used, used < size ? size - used : 0, "%s%s", used ? ", " : "",
+                                 rc_backend_name(all[k]));
+    }
+    return buf;
+}
+
+int rcp_parse_backend(const char *cmd, const char *s, uint32_t *backend)
+{
+    char avail[64];
+    uint32_t b;
+    if (strcmp(s, "auto") == 0) b = RC_BACKEND_AUTO;
+    else if (strcmp(s, "bvh") == 0) b = RC_BACKEND_BVH;
+    else if (strcmp(s, "embree") == 0) b = RC_BACKEND_EMBREE;
+    else if (strcmp(s, "vulkan") == 0) b = RC_BACKEND_VULKAN;
+    else {
+        rcp_usage_error(cmd, "unknown backend '%s' (choose auto or one built into this library: %s)", s,
+                        rcp_available_backends(avail, sizeof avail));
+        return -1;
+    }
+    if (b != RC_BACKEND_AUTO && !rc_backend_available(b)) {
+        rcp_usage_error(cmd, "backend '%s' is not built into this library (available: %s, or auto)", s,
+                        rcp_available_backends(avail, sizeof avail));
+        return -1;
+    }
+    *backend = b;
+    return 0;
+}
+
+static const char *const sensor_names[] = {"vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40"};
+
+int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset)
+{
+    uint32_t p = rc_preset_from_name(s);
+    if (p == 0) {
+        size_t k;
+        char list[128];
+        size_t used = 0;
+        list[0] = 0;
+        for (k = 0; k < sizeof sensor_names / sizeof sensor_names[0]; k++)
+            used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", k ? ", " : "", sensor_names[k]);
+        rcp_usage_error(cmd, "unknown sensor '%s' (choose one of: %s)", s, list);
+        return -1;
+    }
+    *preset = p;
+    return 0;
+}
+
+static rc_scene_desc scene_desc_for(const rcu_mesh *mesh)
+{
+    rc_scene_desc sd = rc_scene_desc_default();
+    sd.max_geometries = 1;
+    sd.max_triangles = mesh->triangle_count;
+    sd.max_vertices = 0;          /* the mesh is referenced in place, not copied */
+    sd.max_copied_triangles = 0;
+    return sd;
+}
+
+int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                    const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes)
+{
+    rc_context_desc cd = rc_context_desc_default();
+    size_t ctx_bytes = 0, sb = 0, sum;
+    rc_status st;
+    uint32_t k;
+    cd.backend = backend;
+    cd.thread_count = threads;
+    if ((st = rc_context_memory_requirements(&cd, &ctx_bytes)) != RC_OK)
+        return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
+    sum = ctx_bytes;
+    if (mesh) {
+        /* The scene's figure needs a context of the same backend: make a small
+         * one (one thread, an arena of just its own size) to ask it. */
+        rc_context_desc pd = cd;
+        rc_context *probe = NULL;
+        rc_scene_desc sd = scene_desc_for(mesh);
+        size_t probe_bytes = 0;
+        pd.thread_count = 1;
+        if ((st = rc_context_memory_requirements(&pd, &probe_bytes)) != RC_OK)
+            return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
+        pd.memory_size = probe_bytes;
+        if ((st = rc_context_create(&pd, &probe)) != RC_OK)
+            return rcp_lib_error(cmd, NULL, "rc_context_create (sizing probe)", st);
+        st = rc_scene_memory_requirements(probe, &sd, &sb);
+        if (st != RC_OK) {
+            rcp_lib_error(cmd, probe, "rc_scene_memory_requirements", st);
+            rc_context_destroy(probe);
+            return RCP_EXIT_FAIL;
+        }
+        rc_context_destroy(probe);
+        sum += sb;
+    }
+    for (k = 0; k < preset_count; k++) {
+        size_t b = 0;
+        if ((st = rc_sensor_memory_requirements_preset(presets[k], &b)) != RC_OK)
+            return rcp_lib_error(cmd, NULL, "rc_sensor_memory_requirements_preset", st);
+        sum += b;
+    }
+    *total = sum;
+    if (scene_bytes) *scene_bytes = sb;
+    return RCP_EXIT_OK;
+}
+
+static void log_to_stderr(void *user, uint32_t level, const char *message)
+{
+    (void)user;
+    /* errors come back as a status + rc_context_last_error and are printed
+     * there; warnings have no other way out */
+    if (level == RC_LOG_WARN) fprintf(stderr, "rangecast: library warning: %s\n", message);
+}
+
+void rcp_world_destroy(rcp_world *world)
+{
+    if (!world) return;
+    rc_context_destroy(world->ctx); /* scenes and sensors go with it */
+    memset(world, 0, sizeof *world);
+}
+
+int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                     const uint32_t *presets, uint32_t preset_count, rcp_world *w)
+{
+    rc_context_desc cd = rc_context_desc_default();
+    rc_status st;
+    uint32_t k;
+    const char *call;
+    memset(w, 0, sizeof *w);
+    if (preset_count > RCP_MAX_SENSORS) return rcp_fail(cmd, "too many sensors");
+    if (rcp_arena_bytes(cmd, backend, threads, mesh, presets, preset_count, &w->arena_bytes,
+                        &w->scene_bytes) != RCP_EXIT_OK)
+        return RCP_EXIT_FAIL;
+    cd.backend = backend;
+    cd.thread_count = threads;
+    cd.memory = NULL;             /* the library mallocs exactly this much, once */
+    cd.memory_size = w->arena_bytes;
+    cd.log = log_to_stderr;
+    if ((st = rc_context_create(&cd, &w->ctx)) != RC_OK)
+        return rcp_lib_error(cmd, NULL, "rc_context_create", st);
+    rc_context_get_backend(w->ctx, &w->backend);
+    rc_context_get_thread_count(w->ctx, &w->threads);
+    if (mesh) {
+        rc_scene_desc sd = scene_desc_for(mesh);
+        rc_mesh_desc md = rc_mesh_desc_default();
+        uint32_t geom = 0;
+        double t0;
+        md.flags = RC_MESH_REFERENCE;
+        md.vertices = mesh->vertices;
+        md.vertex_count = mesh->vertex_count;
+        md.indices = mesh->indices;
+        md.triangle_count = mesh->triangle_count;
+        call = "rc_scene_create";
+        if ((st = rc_scene_create(w->ctx, &sd, &w->scene)) != RC_OK) goto fail;
+        call = "rc_scene_add_mesh";
+        if ((st = rc_scene_add_mesh(w->scene, &md, &geom)) != RC_OK) goto fail;
+        call = "rc_scene_commit";
+        t0 = rcu_now();
+        if ((st = rc_scene_commit(w->scene)) != RC_OK) goto fail;
+        w->build_s = rcu_now() - t0;
+    }
+    call = "rc_sensor_create_preset";
+    for (k = 0; k < preset_count; k++) {
+        if ((st = rc_sensor_create_preset(w->ctx, presets[k], &w->sensors[k])) != RC_OK) goto fail;
+        w->sensor_count++;
+    }
+    return RCP_EXIT_OK;
+fail:
+    rcp_lib_error(cmd, w->ctx, call, st);
+    if (st == RC_ERR_OUT_OF_MEMORY)
+        fprintf(stderr, "rangecast %s: (the arena was sized with rc_*_memory_requirements to %zu bytes; "
+                        "the library's size query and its use disagree)\n", cmd, w->arena_bytes);
+    rcp_world_destroy(w);
+    return RCP_EXIT_FAIL;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double rcp_median(double *v, size_t n)
+{
+    if (n == 0) return NAN;
+    qsort(v, n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+const char *rcp_thousands(uint64_t v, char *buf, size_t size)
+{
+    char tmp[32];
+    int n = snprintf(tmp, sizeof tmp, "%llu", (unsigned long long)v), i, o = 0;
+    for (i = 0; i < n && (size_t)o + 2 < size; i++) {
+        if (i > 0 && (n - i) % 3 == 0) buf[o++] = ',';
+        buf[o++] = tmp[i];
+    }
+    buf[o] = 0;
+    return buf;
+}
+
+const char *rcp_bytes(uint64_t v, char *buf, size_t size)
+{
+    if (v >= (1ull << 30)) snprintf(buf, size, "%.2f GiB", (double)v / (double)(1ull << 30));
+    else if (v >= (1ull << 20)) snprintf(buf, size, "%.1f MiB", (double)v / (double)(1ull << 20));
+    else if (v >= (1ull << 10)) snprintf(buf, size, "%.1f KiB", (double)v / 1024.0);
+    else snprintf(buf, size, "%llu B", (unsigned long long)v);
+    return buf;
+}

@@ -1,0 +1,91 @@
+/* The rangecast program: what every subcommand shares (argument parsing,
+ * messages and exit codes, setting up a context sized exactly for its work). */
+#ifndef RCP_TOOL_H
+#define RCP_TOOL_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "meshgen.h"
+#include "rangecast/rangecast.h"
+
+#define RCP_EXIT_OK    0
+#define RCP_EXIT_FAIL  1 /* a library or file error */
+#define RCP_EXIT_USAGE 2 /* bad arguments */
+
+#if defined(__GNUC__)
+#define RCP_PRINTF(a, b) __attribute__((format(printf, a, b)))
+#else
+#define RCP_PRINTF(a, b)
+#endif
+
+/* Subcommands: argv[0] is the subcommand's name. */
+int rcp_cmd_simulate(int argc, char **argv);
+int rcp_cmd_bench(int argc, char **argv);
+int rcp_cmd_demo(int argc, char **argv);
+int rcp_cmd_info(int argc, char **argv);
+int rcp_cmd_gen(int argc, char **argv);
+
+/* "rangecast CMD: message" + a pointer to --help on stderr; returns RCP_EXIT_USAGE. */
+int rcp_usage_error(const char *cmd, const char *fmt, ...) RCP_PRINTF(2, 3);
+/* "rangecast CMD: message" on stderr; returns RCP_EXIT_FAIL. */
+int rcp_fail(const char *cmd, const char *fmt, ...) RCP_PRINTF(2, 3);
+/* A failed library call: "rangecast CMD: CALL: <rc_status_string>: <last error>";
+ * returns RCP_EXIT_FAIL. ctx may be NULL. */
+int rcp_lib_error(const char *cmd, const rc_context *ctx, const char *call, rc_status st);
+
+/* Arguments. rcp_opt matches argv[*i] against "--name VALUE" or "--name=VALUE":
+ * returns 1 and sets *value (advancing *i past a separate value), 0 when it is
+ * another argument, -1 when the value is missing (message printed). */
+int rcp_opt(int argc, char **argv, int *i, const char *name, const char **value);
+int rcp_is_help(const char *arg);
+/* Numbers; 0 on success, -1 on a malformed or out-of-range value (no message). */
+int rcp_parse_u32(const char *s, uint32_t *out);
+/* A count with an optional suffix: 1k = 1000, 1M = 10^6, 1G = 10^9. */
+int rcp_parse_count(const char *s, uint64_t *out);
+int rcp_parse_float(const char *s, float *out);
+/* Exactly n comma-separated floats. */
+int rcp_parse_floats(const char *s, float *out, int n);
+/* bvh | embree | vulkan | auto -> RC_BACKEND_*; prints an error that lists the
+ * backends built into this library and returns -1 when unknown or absent. */
+int rcp_parse_backend(const char *cmd, const char *s, uint32_t *backend);
+/* "bvh, embree" ... : the backends built in. */
+const char *rcp_available_backends(char *buf, size_t size);
+/* A preset name -> RC_PRESET_*, or -1 with a message listing the presets. */
+int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset);
+
+/* A context sized exactly for one scene holding `mesh` (referenced in place,
+ * so the mesh must outlive the world) and the given sensor presets. */
+#define RCP_MAX_SENSORS 4
+typedef struct rcp_world {
+    rc_context *ctx;
+    rc_scene *scene;                     /* NULL when no mesh was given */
+    rc_sensor *sensors[RCP_MAX_SENSORS];
+    uint32_t sensor_count;
+    uint32_t backend;                    /* the backend in use */
+    uint32_t threads;                    /* threads simulate uses */
+    size_t arena_bytes;                  /* desc.memory_size we asked for */
+    size_t scene_bytes;                  /* rc_scene_memory_requirements */
+    double build_s;                      /* wall time of rc_scene_commit */
+} rcp_world;
+
+/* Creates the world; on failure prints the error (as cmd) and returns
+ * RCP_EXIT_FAIL with *world cleaned up. */
+int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                     const uint32_t *presets, uint32_t preset_count, rcp_world *world);
+void rcp_world_destroy(rcp_world *world);
+
+/* Exact arena bytes of a context + one scene of this mesh on a backend
+ * (threads as given), without building anything. */
+int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                    const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes);
+
+/* Median of v[0..n) (sorts v); NaN when n is 0. */
+double rcp_median(double *v, size_t n);
+
+/* "1,234,567" into buf. */
+const char *rcp_thousands(uint64_t v, char *buf, size_t size);
+/* "12.3 MiB" into buf. */
+const char *rcp_bytes(uint64_t v, char *buf, size_t size);
+
+#endif
