@@ -382,7 +382,7 @@ static void check_closed(uint32_t b, const rcu_mesh *m, const float origin[3])
                 for (j = 0; j < 3; ++j) dirs[3 * k + j] = a[j] + ts[s] * (c[j] - a[j]) - origin[j];
             }
     }
-    sensor = rct_sensor_dirs(ctx, dirs, n, 0.0f, 1000.0f);
+    sensor = rct_sensor_dirs(ctx, dirs, n, 0.0f, 1.0e5f);
     rct_buffers_alloc(&buf, n, RC_ATTR_HITS);
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res));
     for (i = 0; i < n; ++i) escapes += buf.res.hits[i] ? 0u : 1u;
