@@ -277,7 +277,9 @@ typedef struct rc_mesh_desc {
     uint32_t flags;             /* RC_MESH_REFERENCE or RC_MESH_COPY */
     const float *vertices;      /* x, y, z per vertex */
     uint64_t vertex_count;
-    uint32_t vertex_stride;     /* bytes between vertices; 0 = 12. Multiple of 4. */
+    uint32_t vertex_stride;     /* bytes between vertices; 0 = 12. Multiple of 4. The array
+                                   holds vertex_count * stride bytes (Embree shares arrays of
+                                   stride >= 16 in place and copies packed ones). */
     uint32_t reserved0;
     const uint32_t *indices;    /* 3 vertex indices per triangle */
     uint64_t triangle_count;

@@ -118,15 +118,15 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
                                                        "rc_context_memory_requirements");
     block = desc->memory;
     if (!block) {
-        /* The one allocation of the library (16-aligned by malloc on every
-         * platform we target; checked anyway). */
-        owned = malloc(size);
+        /* The one allocation of the library. malloc aligns to 16 on x86_64
+         * and aarch64 but only to 8 on 32-bit ARM (glibc armhf, newlib), so
+         * take RC_ARENA_ALIGNMENT - 1 more and align up (C99: no
+         * posix_memalign/aligned_alloc); owned keeps malloc's pointer. */
+        if (size > (size_t)-1 - (RC_ARENA_ALIGNMENT - 1))
+            return create_fail(desc, RC_ERR_OUT_OF_MEMORY, "rc_context_create: memory_size too large");
+        owned = malloc(size + (RC_ARENA_ALIGNMENT - 1));
         if (!owned) return create_fail(desc, RC_ERR_OUT_OF_MEMORY, "rc_context_create: malloc of the arena failed");
-        if (((uintptr_t)owned % RC_ARENA_ALIGNMENT) != 0) {
-            free(owned);
-            return create_fail(desc, RC_ERR_OUT_OF_MEMORY, "rc_context_create: malloc returned a misaligned block");
-        }
-        block = owned;
+        block = (unsigned char *)owned + ((RC_ARENA_ALIGNMENT - (uintptr_t)owned % RC_ARENA_ALIGNMENT) % RC_ARENA_ALIGNMENT);
     }
     rc__arena_init(&arena, block, size);
     ctx = (rc_context *)rc__arena_calloc(&arena, sizeof *ctx);
@@ -145,6 +145,15 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
 
     st = rc__pool_create(&ctx->arena, threads, &ctx->pool);
     if (st == RC_OK) st = backend->init(ctx, desc);
+    if (st != RC_OK && ctx->pool && desc->backend == RC_BACKEND_AUTO && backend != &rc__backend_bvh) {
+        /* AUTO: a backend that is built in but cannot start here (no device)
+         * falls back to the built-in one. Its failed init released what it took. */
+        if (desc->log) desc->log(desc->log_user, RC_LOG_WARN, "AUTO: preferred backend failed to start; using bvh");
+        backend = &rc__backend_bvh;
+        ctx->backend = backend;
+        ctx->backend_id = backend->id;
+        st = backend->init(ctx, desc);
+    }
     if (st != RC_OK) {
         if (ctx->pool) rc__pool_destroy(&ctx->arena, ctx->pool);
         ctx->magic = RC__MAGIC_DEAD;

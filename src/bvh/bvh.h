@@ -22,6 +22,9 @@
 
 #define RC__BVH_MESH_LEAF_SIZE 4u  /* triangles per leaf in mesh BVHs */
 #define RC__BVH_TOP_LEAF_SIZE 1u   /* geometries/instances per leaf in a scene's top level */
+/* The builder keeps every leaf at depth <= RC__BVH_MAX_DEPTH (root = 0), so a
+ * traversal stack of RC__BVH_MAX_DEPTH entries never overflows. */
+#define RC__BVH_MAX_DEPTH 64u
 
 typedef struct rc__aabb {
     float min[3];

@@ -1,6 +1,9 @@
 /* First-fit allocator with address-ordered free list and coalescing. Each block
  * starts with a 16-byte header holding its total size; free blocks keep the
- * next-free pointer in their payload. Deterministic, no system calls. */
+ * next-free pointer in their payload. Deterministic, no system calls.
+ * Block addresses are multiples of RC__ARENA_ALIGN by construction (the base is
+ * aligned, every size is rounded up), so the casts from byte pointers to block
+ * pointers go through void * to tell -Wcast-align (active on armv7) so. */
 #include "core/arena.h"
 
 #include <string.h>
@@ -63,7 +66,7 @@ void *rc__arena_alloc(rc__arena *arena, size_t size)
             size_t rest = f->head.size - need;
             block *b = &f->head;
             if (rest >= MIN_BLOCK) {
-                free_block *tail = (free_block *)((unsigned char *)f + need);
+                free_block *tail = (free_block *)(void *)((unsigned char *)f + need);
                 RC__UNPOISON(tail, sizeof *tail);
                 tail->head.size = rest;
                 tail->head.tag = BLOCK_FREE;
@@ -123,7 +126,7 @@ void rc__arena_free(rc__arena *arena, void *ptr)
 {
     block *b;
     if (!ptr) return;
-    b = (block *)((unsigned char *)ptr - RC__ARENA_HEADER);
+    b = (block *)(void *)((unsigned char *)ptr - RC__ARENA_HEADER);
     if (b->tag != BLOCK_USED) return; /* double free: ignore rather than corrupt */
     arena->used -= b->size;
     insert_free(arena, (free_block *)b);
@@ -134,12 +137,12 @@ void rc__arena_shrink(rc__arena *arena, void *ptr, size_t new_size)
     block *b;
     size_t keep;
     if (!ptr) return;
-    b = (block *)((unsigned char *)ptr - RC__ARENA_HEADER);
+    b = (block *)(void *)((unsigned char *)ptr - RC__ARENA_HEADER);
     if (b->tag != BLOCK_USED) return;
     keep = rc__arena_cost(new_size);
     if (keep >= b->size || b->size - keep < MIN_BLOCK) return;
     {
-        free_block *tail = (free_block *)((unsigned char *)b + keep);
+        free_block *tail = (free_block *)(void *)((unsigned char *)b + keep);
         RC__UNPOISON(tail, sizeof *tail);
         tail->head.size = b->size - keep;
         arena->used -= tail->head.size;

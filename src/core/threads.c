@@ -143,6 +143,8 @@ void rc__pool_run(rc__pool *pool, uint32_t task_count, rc__task_fn fn, void *use
         pthread_mutex_unlock(&pool->lock);
         return;
     }
+#else
+    (void)pool;
 #endif
     {
         uint32_t t;

@@ -1,0 +1,173 @@
+/* The two inner tests of every CPU traversal, as static inline functions so the
+ * scalar path inlines them and later SIMD/packet code can share them:
+ *
+ *   rc__tri_intersect   watertight ray/triangle test (Woop, Benthin, Wald 2013,
+ *                       "Watertight Ray/Triangle Intersection", JCGT 2(1))
+ *   rc__node_hit        robust slab test of a BVH node (Ize 2013, "Robust BVH
+ *                       Ray Traversal", JCGT 2(2)), NaN-safe for zero direction
+ *                       components
+ *
+ * Watertightness rests on two properties of the code below; keep them:
+ *  - every vertex is transformed to ray space by the same expression, so a
+ *    vertex shared by two triangles gets the same 2D coordinates in both;
+ *  - every edge function has the form E(P,Q) = Qx*Py - Qy*Px, so the edge
+ *    shared by two triangles (walked in opposite directions) gives exactly
+ *    -E in the other triangle. That only holds when the compiler does not fuse
+ *    a product and the subtraction into an FMA: compile with FP contraction off
+ *    (GCC's default for -std=c99; clang needs the pragma below; GCC in gnu99
+ *    mode on FMA targets needs -ffp-contract=off).
+ * Exactly zero edge functions are recomputed in double (products of floats are
+ * exact there), which settles rays through edges and vertices consistently. */
+#ifndef RC_BVH_INTERSECT_H
+#define RC_BVH_INTERSECT_H
+
+#include "bvh/mesh.h"
+
+#include <float.h>
+
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
+/* Ize's bound: slab exit distances are scaled by 1 + 2 * gamma(3) (rounded up)
+ * so rounding in (plane - org) * inv_dir can never reject a box the ray meets. */
+#define RC__SLAB_FAR_SCALE (1.0f + 4.0f * FLT_EPSILON)
+
+/* Per-ray constants of the slab test. */
+typedef struct rc__slab_ray {
+    float org[3];
+    float inv[3];
+    int neg[3]; /* 1 where inv_dir < 0 (including -0.0 directions): the ray enters by bmax */
+    float tmin; /* 0: where intervals start */
+} rc__slab_ray;
+
+static inline void rc__slab_ray_init(rc__slab_ray *s, const rc__ray *ray)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        s->org[k] = ray->org[k];
+        s->inv[k] = ray->inv_dir[k];
+        s->neg[k] = ray->inv_dir[k] < 0.0f;
+    }
+    s->tmin = 0.0f;
+}
+
+/* 1 when the ray meets the node's box within [0, tmax] (conservatively);
+ * *tnear gets the entry distance (>= 0). negx/y/z are s->neg; traversals that
+ * specialise on the ray's octant pass constants so the plane choice folds away.
+ * A zero direction component gives an infinite reciprocal, and a NaN (0 * inf)
+ * where the origin lies exactly on a plane: the comparisons below are written
+ * so a NaN never replaces the running value, i.e. that plane imposes nothing
+ * (the box is closed). An empty box (min = +inf, max = -inf) is always missed. */
+static inline int rc__node_hit_octant(const rc__bvh_node *n, const rc__slab_ray *s, float tmax,
+                                      float *tnear, int negx, int negy, int negz)
+{
+    const float nx = ((negx ? n->bmax[0] : n->bmin[0]) - s->org[0]) * s->inv[0];
+    const float ny = ((negy ? n->bmax[1] : n->bmin[1]) - s->org[1]) * s->inv[1];
+    const float nz = ((negz ? n->bmax[2] : n->bmin[2]) - s->org[2]) * s->inv[2];
+    const float fx = ((negx ? n->bmin[0] : n->bmax[0]) - s->org[0]) * s->inv[0];
+    const float fy = ((negy ? n->bmin[1] : n->bmax[1]) - s->org[1]) * s->inv[1];
+    const float fz = ((negz ? n->bmin[2] : n->bmax[2]) - s->org[2]) * s->inv[2];
+    float tn = s->tmin, tf = tmax;
+    /* a > b ? a : b keeps b when a is NaN; b is never NaN */
+    tn = nx > tn ? nx : tn;
+    tn = ny > tn ? ny : tn;
+    tn = nz > tn ? nz : tn;
+    tf = fx < tf ? fx : tf;
+    tf = fy < tf ? fy : tf;
+    tf = fz < tf ? fz : tf;
+    *tnear = tn;
+    return tn <= tf * RC__SLAB_FAR_SCALE;
+}
+
+static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, float tmax, float *tnear)
+{
+    return rc__node_hit_octant(n, s, tmax, tnear, s->neg[0], s->neg[1], s->neg[2]);
+}
+
+#if defined(__GNUC__)
+#define RC__NOINLINE __attribute__((noinline, unused))
+#define RC__FORCE_INLINE inline __attribute__((always_inline))
+#else
+#define RC__NOINLINE
+#define RC__FORCE_INLINE inline
+#endif
+
+/* Exactly zero edge function(s): recompute all three in double. */
+static RC__NOINLINE void rc__tri_edges_double(float Ax, float Ay, float Bx, float By, float Cx,
+                                              float Cy, float *U, float *V, float *W)
+{
+    const double CxBy = (double)Cx * (double)By, CyBx = (double)Cy * (double)Bx;
+    const double AxCy = (double)Ax * (double)Cy, AyCx = (double)Ay * (double)Cx;
+    const double BxAy = (double)Bx * (double)Ay, ByAx = (double)By * (double)Ax;
+    *U = (float)(CxBy - CyBx);
+    *V = (float)(AxCy - AyCx);
+    *W = (float)(BxAy - ByAx);
+}
+
+/* 1 when (b - a) x (c - a) is exactly zero (to double precision): a zero-area
+ * triangle. Sheared 2D coordinates of a collinear triangle can round to a
+ * non-zero area, so the hit path checks this explicitly (it runs only for rays
+ * that pass the inside test). */
+static RC__NOINLINE int rc__tri_zero_area(const float *a, const float *b, const float *c)
+{
+    const double e1x = (double)b[0] - a[0], e1y = (double)b[1] - a[1], e1z = (double)b[2] - a[2];
+    const double e2x = (double)c[0] - a[0], e2y = (double)c[1] - a[1], e2z = (double)c[2] - a[2];
+    return e1y * e2z - e1z * e2y == 0.0 && e1z * e2x - e1x * e2z == 0.0 &&
+           e1x * e2y - e1y * e2x == 0.0;
+}
+
+/* Watertight test of triangle (a, b, c), either winding. On a hit with t > 0
+ * returns 1 with *t (in units of |dir|), the barycentrics *u (weight of b) and
+ * *v (weight of c): the point is (1 - u - v) a + u b + v c, as in Embree. The
+ * caller compares t with its current nearest. */
+static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, const float *b, const float *c,
+                                    float *t, float *u, float *v)
+{
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    const float ox = r->org[kx], oy = r->org[ky], oz = r->org[kz];
+    const float sx = r->sx, sy = r->sy;
+    /* vertices relative to the origin, then sheared so the ray is +z */
+    const float az = a[kz] - oz, bz = b[kz] - oz, cz = c[kz] - oz;
+    const float Ax = (a[kx] - ox) - sx * az, Ay = (a[ky] - oy) - sy * az;
+    const float Bx = (b[kx] - ox) - sx * bz, By = (b[ky] - oy) - sy * bz;
+    const float Cx = (c[kx] - ox) - sx * cz, Cy = (c[ky] - oy) - sy * cz;
+    float U = Cx * By - Cy * Bx; /* E(B, C) */
+    float V = Ax * Cy - Ay * Cx; /* E(C, A) */
+    float W = Bx * Ay - By * Ax; /* E(A, B) */
+    float det, T, tt;
+    /* Rounding is monotonic, so a non-zero float edge function has the sign of
+     * the exact one: mixed non-zero signs reject at once. Only then are zeros
+     * settled in double. */
+    {
+        /* min/max instead of six branches (NaN only from overflow: it makes
+         * det or t NaN below, which rejects) */
+        const float lo = U < V ? (U < W ? U : W) : (V < W ? V : W);
+        const float hi = U > V ? (U > W ? U : W) : (V > W ? V : W);
+        if (lo < 0.0f && hi > 0.0f) return 0;
+    }
+    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+        rc__tri_edges_double(Ax, Ay, Bx, By, Cx, Cy, &U, &V, &W);
+        if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
+    }
+    det = U + V + W;
+    if (det == 0.0f) return 0;
+    T = U * (r->sz * az) + V * (r->sz * bz) + W * (r->sz * cz);
+    tt = T / det;
+    if (!(tt > 0.0f)) return 0;
+    if (rc__tri_zero_area(a, b, c)) return 0;
+    *t = tt;
+    *u = V / det;
+    *v = W / det;
+    return 1;
+}
+
+/* Tie rule of rc__mesh_intersect: (inst, geom, prim) lexicographically smaller. */
+static inline int rc__hit_key_less(uint32_t inst, uint32_t geom, uint32_t prim, const rc__hit *h)
+{
+    if (inst != h->inst) return inst < h->inst;
+    if (geom != h->geom) return geom < h->geom;
+    return prim < h->prim;
+}
+
+#endif

@@ -1,0 +1,241 @@
+/* Single-ray queries on a triangle mesh with its BVH: ray setup, triangle
+ * bounds, ordered nearest-hit traversal, any-hit occlusion, triangle normals.
+ * The inner tests are in intersect.h. */
+#include "bvh/mesh.h"
+
+#include "bvh/intersect.h"
+#include "core/common.h"
+
+#include <math.h>
+
+void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3])
+{
+    float ax, ay, az, m;
+    int k, kz = 0;
+    for (k = 0; k < 3; ++k) {
+        ray->org[k] = org[k];
+        ray->dir[k] = dir[k];
+        ray->inv_dir[k] = 1.0f / dir[k]; /* +-inf for a +-0 component */
+    }
+    ax = fabsf(dir[0]);
+    ay = fabsf(dir[1]);
+    az = fabsf(dir[2]);
+    m = ax;
+    if (ay > m) {
+        kz = 1;
+        m = ay;
+    }
+    if (az > m) kz = 2;
+    ray->kz = kz;
+    ray->kx = kz == 2 ? 0 : kz + 1;
+    ray->ky = ray->kx == 2 ? 0 : ray->kx + 1;
+    if (dir[kz] < 0.0f) { /* keep the winding: swap kx and ky */
+        int t = ray->kx;
+        ray->kx = ray->ky;
+        ray->ky = t;
+    }
+    ray->sx = dir[ray->kx] / dir[kz];
+    ray->sy = dir[ray->ky] / dir[kz];
+    ray->sz = 1.0f / dir[kz];
+}
+
+static const float *rc__vertex(const rc__mesh *mesh, uint32_t i)
+{
+    return mesh->vertices + (size_t)i * mesh->stride;
+}
+
+void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out)
+{
+    uint32_t i;
+    int k;
+    for (i = 0; i < mesh->triangle_count; ++i) {
+        const uint32_t *tri = mesh->indices + (size_t)3 * i;
+        const float *a = rc__vertex(mesh, tri[0]), *b = rc__vertex(mesh, tri[1]);
+        const float *c = rc__vertex(mesh, tri[2]);
+        for (k = 0; k < 3; ++k) {
+            float lo = a[k], hi = a[k];
+            lo = b[k] < lo ? b[k] : lo;
+            hi = b[k] > hi ? b[k] : hi;
+            lo = c[k] < lo ? c[k] : lo;
+            hi = c[k] > hi ? c[k] : hi;
+            out[i].min[k] = lo;
+            out[i].max[k] = hi;
+        }
+    }
+}
+
+void rc__mesh_triangle_normal(const rc__mesh *mesh, uint32_t prim, float n[3])
+{
+    const uint32_t *tri = mesh->indices + (size_t)3 * prim;
+    const float *a = rc__vertex(mesh, tri[0]), *b = rc__vertex(mesh, tri[1]);
+    const float *c = rc__vertex(mesh, tri[2]);
+    const float e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
+    const float e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+}
+
+#if defined(__GNUC__)
+#define RC__ALWAYS_INLINE inline __attribute__((always_inline))
+#define RC__PREFETCH(p) __builtin_prefetch(p)
+#else
+#define RC__ALWAYS_INLINE inline
+#define RC__PREFETCH(p) ((void)(p))
+#endif
+
+typedef struct rc__trav_entry {
+    uint32_t index; /* the node's index and count fields */
+    uint32_t count;
+    float tnear;
+} rc__trav_entry;
+
+/* Out of line on purpose: when the compiler sees s.tmin == 0 it may turn
+ * max(tnear, 0) into a data-dependent branch. */
+static RC__NOINLINE void rc__slab_init_opaque(rc__slab_ray *s, const rc__ray *ray)
+{
+    rc__slab_ray_init(s, ray);
+}
+
+/* Starts fetching what visiting a node with these fields reads first: its
+ * children's pair, or its leaf's refs. */
+static RC__ALWAYS_INLINE void rc__prefetch_node(const rc__bvh_node *nodes, const uint32_t *refs,
+                                                uint32_t index, uint32_t count)
+{
+    if (count == 0) {
+        RC__PREFETCH(nodes + index);
+    } else {
+        RC__PREFETCH(refs + index);
+    }
+}
+
+/* Ordered traversal: at an interior node both children are tested, the nearer
+ * is visited next and the farther pushed with its entry distance; entries are
+ * dropped when popped if they start beyond the nearest hit. Boxes with entry
+ * distance equal to the current t are still visited (the tie rule). The loop
+ * carries the (index, count) fields of the node to visit, read when its box
+ * was tested, and prefetches one level ahead. With any_hit, returns at the
+ * first hit with t < tmax. negx/y/z: the ray's octant, constants in each copy. */
+static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom,
+                                          uint32_t inst, rc__hit *hit, float tmax, int any_hit,
+                                          int negx, int negy, int negz)
+{
+    const rc__bvh_node *nodes = mesh->bvh.nodes;
+    const uint32_t *refs = mesh->bvh.refs;
+    const uint32_t *indices = mesh->indices;
+    const float *vertices = mesh->vertices;
+    const size_t stride = mesh->stride;
+    const rc__ray r = *ray;
+    rc__slab_ray s;
+    rc__trav_entry stack[RC__BVH_MAX_DEPTH];
+    uint32_t sp = 0, index, count;
+    float tcur = tmax, tn;
+    int found = 0;
+
+    if (mesh->bvh.node_count == 0) return 0;
+    rc__slab_init_opaque(&s, &r);
+    if (!rc__node_hit_octant(&nodes[0], &s, tcur, &tn, negx, negy, negz)) return 0;
+    index = nodes[0].index;
+    count = nodes[0].count;
+    for (;;) {
+        if (count == 0) {
+            const rc__bvh_node *a = nodes + index, *b = a + 1;
+            const uint32_t ai = a->index, ac = a->count, bi = b->index, bc = b->count;
+            float t0, t1;
+            int h0, h1;
+            rc__prefetch_node(nodes, refs, ai, ac);
+            rc__prefetch_node(nodes, refs, bi, bc);
+            h0 = rc__node_hit_octant(a, &s, tcur, &t0, negx, negy, negz);
+            h1 = rc__node_hit_octant(b, &s, tcur, &t1, negx, negy, negz);
+            if (h0 && h1) {
+                rc__trav_entry e;
+                if (t1 < t0) {
+                    index = bi;
+                    count = bc;
+                    e.index = ai;
+                    e.count = ac;
+                    e.tnear = t0;
+                } else {
+                    index = ai;
+                    count = ac;
+                    e.index = bi;
+                    e.count = bc;
+                    e.tnear = t1;
+                }
+                /* the builder caps depth so this always holds; a deeper
+                 * (corrupt) tree loses branches instead of the stack */
+                if (RC__LIKELY(sp < RC__BVH_MAX_DEPTH)) stack[sp++] = e;
+                continue;
+            }
+            if (h0) {
+                index = ai;
+                count = ac;
+                continue;
+            }
+            if (h1) {
+                index = bi;
+                count = bc;
+                continue;
+            }
+        } else {
+            const uint32_t end = index + count;
+            uint32_t j;
+            for (j = index; j < end; ++j) {
+                const uint32_t prim = refs[j];
+                const uint32_t *tri = indices + (size_t)3 * prim;
+                float t, u, v;
+                if (!rc__tri_intersect(&r, vertices + tri[0] * stride, vertices + tri[1] * stride,
+                                       vertices + tri[2] * stride, &t, &u, &v))
+                    continue;
+                if (any_hit) {
+                    if (t < tmax) return 1;
+                    continue;
+                }
+                if (t > tcur) continue;
+                if (t == tcur && !rc__hit_key_less(inst, geom, prim, hit)) continue;
+                hit->t = t;
+                hit->u = u;
+                hit->v = v;
+                hit->prim = prim;
+                hit->geom = geom;
+                hit->inst = inst;
+                tcur = t;
+                found = 1;
+            }
+        }
+        for (;;) {
+            if (sp == 0) return found;
+            --sp;
+            if (stack[sp].tnear <= tcur) {
+                index = stack[sp].index;
+                count = stack[sp].count;
+                break;
+            }
+        }
+    }
+}
+
+/* One copy of the traversal per ray octant (the slab planes become constants). */
+#define RC__OCTANTS(call, ...)                                      \
+    switch ((ray->inv_dir[0] < 0.0f) | (ray->inv_dir[1] < 0.0f) << 1 | \
+            (ray->inv_dir[2] < 0.0f) << 2) {                        \
+    case 0: return call(__VA_ARGS__, 0, 0, 0);                      \
+    case 1: return call(__VA_ARGS__, 1, 0, 0);                      \
+    case 2: return call(__VA_ARGS__, 0, 1, 0);                      \
+    case 3: return call(__VA_ARGS__, 1, 1, 0);                      \
+    case 4: return call(__VA_ARGS__, 0, 0, 1);                      \
+    case 5: return call(__VA_ARGS__, 1, 0, 1);                      \
+    case 6: return call(__VA_ARGS__, 0, 1, 1);                      \
+    default: return call(__VA_ARGS__, 1, 1, 1);                     \
+    }
+
+int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
+                       rc__hit *hit)
+{
+    RC__OCTANTS(rc__traverse, mesh, ray, geom, inst, hit, hit->t, 0)
+}
+
+int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax)
+{
+    RC__OCTANTS(rc__traverse, mesh, ray, 0, 0, NULL, tmax, 1)
+}

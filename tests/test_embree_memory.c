@@ -1,0 +1,286 @@
+/* The Embree backend's memory and errors: the memory monitor behind
+ * rc_memory_stats.backend_bytes, zero-copy sharing of mesh arrays, the
+ * internal budget (RC_ERR_OUT_OF_MEMORY, a scene that stays uncommitted and
+ * commits once the budget allows), the exact arena figures, and Embree
+ * errors turned into status codes with Embree's message. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "rc_test.h"
+
+#include "backend/embree_internal.h"
+
+/* RTCError values (the same in Embree 3 and 4); the test needs no Embree header. */
+#define RTC_ERR_INVALID_OPERATION 3
+#define RTC_ERR_OUT_OF_MEMORY 4
+#define RTC_ERR_UNSUPPORTED_CPU 5
+
+#define NEED_EMBREE()                                       \
+    do {                                                    \
+        if (!rct_backend_usable(RC_BACKEND_EMBREE)) skip(); \
+    } while (0)
+
+static uint64_t backend_bytes(rc_context *ctx)
+{
+    rc_memory_stats s = rc_memory_stats_default();
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &s));
+    return s.backend_bytes;
+}
+
+/* Commits m into a fresh one-mesh scene as flags / stride say; returns the
+ * backend bytes held after the commit. */
+static uint64_t committed_bytes(const rcu_mesh *m, uint32_t flags, const float *vertices, uint32_t stride)
+{
+    rc_context *ctx = rct_context(RC_BACKEND_EMBREE, 1, 0);
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    rc_scene *scene;
+    uint32_t g;
+    uint64_t bytes;
+    assert_int_equal(backend_bytes(ctx), 0);
+    sd.max_triangles = m->triangle_count;
+    if (flags == RC_MESH_COPY) {
+        sd.max_vertices = m->vertex_count;
+        sd.max_copied_triangles = m->triangle_count;
+    }
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    md.flags = flags;
+    md.vertices = vertices;
+    md.vertex_stride = stride;
+    md.vertex_count = m->vertex_count;
+    md.indices = m->indices;
+    md.triangle_count = m->triangle_count;
+    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+    RCT_OK(ctx, rc_scene_commit(scene));
+    bytes = backend_bytes(ctx);
+    assert_true(rc__embree_options_of(ctx)->bytes_peak >= bytes);
+    RCT_OK(ctx, rc_scene_destroy(scene));
+    assert_int_equal(backend_bytes(ctx), 0); /* every byte Embree took came back */
+    rc_context_destroy(ctx);
+    return bytes;
+}
+
+/* backend_bytes follows Embree's allocations; the mesh arrays are shared
+ * (not copied) except packed xyz referenced in place, which Embree's 16-byte
+ * vertex loads cannot read safely: that one copy is 12 bytes a vertex. */
+static void test_monitor_and_sharing(void **state)
+{
+    rcu_mesh m;
+    float *v16;
+    uint64_t referenced, copied, strided;
+    uint32_t i;
+    (void)state;
+    NEED_EMBREE();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000, &m), 0);
+    v16 = (float *)malloc(sizeof(float) * 4u * m.vertex_count);
+    assert_non_null(v16);
+    for (i = 0; i < m.vertex_count; ++i) {
+        memcpy(v16 + 4u * i, m.vertices + 3u * i, 3 * sizeof(float));
+        v16[4u * i + 3u] = 0.0f;
+    }
+    referenced = committed_bytes(&m, RC_MESH_REFERENCE, m.vertices, 0);
+    copied = committed_bytes(&m, RC_MESH_COPY, m.vertices, 0);
+    strided = committed_bytes(&m, RC_MESH_REFERENCE, v16, 16);
+    print_message("Embree bytes for %u triangles: referenced xyz %llu, RC_MESH_COPY %llu, stride 16 %llu\n",
+                  (unsigned)m.triangle_count, (unsigned long long)referenced, (unsigned long long)copied,
+                  (unsigned long long)strided);
+    /* the BVH alone: more than a few bytes a triangle */
+    assert_true(copied > 8u * (uint64_t)m.triangle_count);
+    assert_int_equal(copied, strided);
+    assert_true(referenced >= copied + 12u * (uint64_t)m.vertex_count);
+    assert_true(referenced <= copied + 12u * (uint64_t)m.vertex_count + 64u);
+    free(v16);
+    rcu_mesh_free(&m);
+}
+
+/* The budget: too small fails the commit with RC_ERR_OUT_OF_MEMORY and a
+ * message naming it, the scene stays uncommitted; with room it commits and
+ * traces. For this mesh (600 KB of copied vertices, a 2 MB duplicate-triangle
+ * table, ~10 MB of build) the budgets fail at the vertex copy, at the table
+ * and in Embree's build, and all come back cleanly. */
+static void test_budget(void **state)
+{
+    static const uint64_t budgets[] = {64u << 10, 1200u << 10, 4u << 20};
+    rcu_mesh m;
+    rc_context *ctx;
+    rc_scene *scene;
+    rc_sensor *sensor;
+    rc_scene_info info = rc_scene_info_default();
+    rc__embree_options *opt;
+    rct_buffers buf;
+    rc_pose pose = rct_pose(0, 0, 0);
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t i, g;
+    (void)state;
+    NEED_EMBREE();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000, &m), 0);
+    ctx = rct_context(RC_BACKEND_EMBREE, 2, 0);
+    opt = rc__embree_options_of(ctx);
+    assert_non_null(opt);
+    assert_int_equal(opt->budget_bytes, 0); /* no budget unless asked */
+    sd.max_triangles = m.triangle_count;
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    md.vertices = m.vertices;
+    md.vertex_count = m.vertex_count;
+    md.indices = m.indices;
+    md.triangle_count = m.triangle_count;
+    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16_360, &sensor));
+    rct_buffers_alloc(&buf, 16u * 360u, RC_ATTR_HITS | RC_ATTR_RANGES);
+    for (i = 0; i < sizeof budgets / sizeof budgets[0]; ++i) {
+        rc_status st;
+        opt->budget_bytes = budgets[i];
+        st = rc_scene_commit(scene);
+        if (st != RC_ERR_OUT_OF_MEMORY)
+            fail_msg("budget %llu: commit gave %s (%s)", (unsigned long long)budgets[i], rc_status_string(st),
+                     rc_context_last_error(ctx));
+        if (!strstr(rc_context_last_error(ctx), "budget"))
+            fail_msg("budget %llu: message does not name the budget: %s", (unsigned long long)budgets[i],
+                     rc_context_last_error(ctx));
+        print_message("budget %llu: %s\n", (unsigned long long)budgets[i], rc_context_last_error(ctx));
+        assert_true(backend_bytes(ctx) <= budgets[i]);
+        RCT_OK(ctx, rc_scene_get_info(scene, &info));
+        assert_int_equal(info.committed, 0);
+        assert_int_equal(rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res), RC_ERR_NOT_COMMITTED);
+    }
+    opt->budget_bytes = 0;
+    RCT_OK(ctx, rc_scene_commit(scene));
+    RCT_OK(ctx, rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res));
+    for (i = 0; i < 16u * 360u; ++i) {
+        assert_int_equal(buf.res.hits[i], 1);
+        assert_true(buf.res.ranges[i] > 19.9f && buf.res.ranges[i] <= 20.0f);
+    }
+    /* a budget above what is held lets a later commit through */
+    opt->budget_bytes = backend_bytes(ctx) * 4u;
+    RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+    RCT_OK(ctx, rc_scene_commit(scene));
+    RCT_OK(ctx, rc_scene_destroy(scene));
+    assert_int_equal(backend_bytes(ctx), 0);
+    rct_buffers_free(&buf);
+    rcu_mesh_free(&m);
+    rc_context_destroy(ctx);
+}
+
+/* rc_scene_memory_requirements is exact on Embree too (the arena holds only
+ * the backend's small tables; Embree's memory is outside it): the queried
+ * block works, one byte less fails cleanly with RC_ERR_OUT_OF_MEMORY. */
+static void test_arena_exact(void **state)
+{
+    rcu_mesh m;
+    const float lo[3] = {-1, -1, -1}, hi[3] = {1, 2, 3};
+    size_t need_ctx, need_scene, extra;
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    (void)state;
+    NEED_EMBREE();
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    sd.max_geometries = 2;
+    sd.max_instances = 3;
+    sd.max_triangles = 12;
+    md.vertices = m.vertices;
+    md.vertex_count = m.vertex_count;
+    md.indices = m.indices;
+    md.triangle_count = m.triangle_count;
+    for (extra = 0; extra < 2; ++extra) {
+        rc_context_desc cd = rc_context_desc_default();
+        rc_context *ctx = NULL;
+        rc_scene *scene;
+        void *block;
+        size_t size;
+        uint32_t g;
+        rc_status st;
+        cd.backend = RC_BACKEND_EMBREE;
+        cd.thread_count = 1;
+        assert_int_equal(rc_context_memory_requirements(&cd, &need_ctx), RC_OK);
+        /* the scene query needs a context of the backend: ask a throwaway one */
+        {
+            rc_context *q = rct_context(RC_BACKEND_EMBREE, 1, 1);
+            RCT_OK(q, rc_scene_memory_requirements(q, &sd, &need_scene));
+            rc_context_destroy(q);
+        }
+        size = need_ctx + need_scene - (extra ? 0u : 1u);
+        block = rct_alloc16(size);
+        cd.memory = block;
+        cd.memory_size = size;
+        RCT_OK(NULL, rc_context_create(&cd, &ctx));
+        RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+        st = rc_scene_commit(scene);
+        if (extra) {
+            RCT_OK(ctx, st);
+        } else {
+            assert_int_equal(st, RC_ERR_OUT_OF_MEMORY);
+            assert_non_null(strstr(rc_context_last_error(ctx), "arena"));
+        }
+        rc_context_destroy(ctx);
+        free(block);
+    }
+    rcu_mesh_free(&m);
+}
+
+/* Embree's errors become status codes with Embree's message: a device that
+ * cannot be made, and errors arriving through the error callback (mapped by
+ * code: out of memory, unsupported CPU, anything else is RC_ERR_BACKEND). */
+static void test_error_mapping(void **state)
+{
+    static const struct {
+        int code;
+        rc_status status;
+        const char *name;
+    } cases[] = {
+        {RTC_ERR_INVALID_OPERATION, RC_ERR_BACKEND, "RTC_ERROR_INVALID_OPERATION"},
+        {RTC_ERR_OUT_OF_MEMORY, RC_ERR_OUT_OF_MEMORY, "RTC_ERROR_OUT_OF_MEMORY"},
+        {RTC_ERR_UNSUPPORTED_CPU, RC_ERR_UNSUPPORTED, "RTC_ERROR_UNSUPPORTED_CPU"},
+        {1, RC_ERR_BACKEND, "RTC_ERROR_UNKNOWN"},
+    };
+    rcu_mesh m;
+    const float lo[3] = {-1, -1, -1}, hi[3] = {1, 2, 3};
+    rc_context *ctx, *bvh;
+    rc_scene *scene;
+    rc_status st;
+    uint32_t i;
+    (void)state;
+    NEED_EMBREE();
+    ctx = rct_context(RC_BACKEND_EMBREE, 2, 0);
+    bvh = rct_context(RC_BACKEND_BVH, 1, 1);
+    assert_int_equal(rc__embree_probe_device(bvh, "threads=1"), RC_ERR_INVALID_ARGUMENT);
+    RCT_OK(ctx, rc__embree_probe_device(ctx, "threads=1"));
+
+    /* a configuration Embree rejects: rtcNewDevice fails */
+    st = rc__embree_probe_device(ctx, "threads=not-a-number,frobnicate=1");
+    assert_int_equal(st, RC_ERR_BACKEND);
+    assert_non_null(strstr(rc_context_last_error(ctx), "rtcNewDevice"));
+    assert_non_null(strstr(rc_context_last_error(ctx), "Embree"));
+    print_message("device failure: %s\n", rc_context_last_error(ctx));
+
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
+        rc__embree_record_error(ctx, cases[i].code, "injected by the test");
+        RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+        st = rc_scene_commit(scene);
+        if (st != cases[i].status)
+            fail_msg("code %d: %s, expected %s", cases[i].code, rc_status_string(st),
+                     rc_status_string(cases[i].status));
+        assert_non_null(strstr(rc_context_last_error(ctx), "injected by the test"));
+        assert_non_null(strstr(rc_context_last_error(ctx), cases[i].name));
+        /* reported once: the next commit goes through */
+        RCT_OK(ctx, rc_scene_commit(scene));
+    }
+    rc_context_destroy(bvh);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&m);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_monitor_and_sharing),
+        cmocka_unit_test(test_budget),
+        cmocka_unit_test(test_arena_exact),
+        cmocka_unit_test(test_error_mapping),
+    };
+    return cmocka_run_group_tests_name("embree memory and errors", tests, NULL, NULL);
+}
