@@ -5,11 +5,15 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mesh_load.h"
 #include "poses.h"
 #include "reference.h"
 #include "tool.h"
+#if defined(RANGECAST_TOOL_WITH_EMBREE)
+#include "embree_single.h"
+#endif
 #include "util.h"
 
 #define BENCH_SPHERE_RADIUS 20.0f  /* the standard workload (see ANCHORS.md) */
@@ -32,7 +36,7 @@ static void usage(FILE *f)
         "  --map FILE         mesh map (.ply, or any Assimp format)\n"
         "  --poses FILE       raw poses: float32 LE x y z qx qy qz qw per pose\n"
         "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40\n"
-        "  --backend B        auto (default), bvh, embree, vulkan\n"
+        "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
@@ -158,6 +162,7 @@ typedef struct bench_args {
     uint64_t triangles, seed;
     const char *sensor_name;
     int set_triangles, set_pose_count, set_seed;
+    int embree_single; /* --backend embree-single: the hand-written rtcIntersect1 loop */
 } bench_args;
 
 static int parse_args(int argc, char **argv, bench_args *a)
@@ -186,7 +191,17 @@ static int parse_args(int argc, char **argv, bench_args *a)
             if (rcp_parse_sensor(cmd, v, &a->preset) != 0) return -1;
             a->sensor_name = v;
         } else if (OPT("--backend")) {
-            if (r < 0 || rcp_parse_backend(cmd, v, &a->backend) != 0) return -1;
+            if (r < 0) return -1;
+            if (strcmp(v, "embree-single") == 0) {
+#if defined(RANGECAST_TOOL_WITH_EMBREE)
+                a->embree_single = 1;
+                a->backend = RC_BACKEND_EMBREE;
+#else
+                return rcp_usage_error(cmd, "--backend embree-single needs the program built with Embree"), -1;
+#endif
+            } else if (rcp_parse_backend(cmd, v, &a->backend) != 0) {
+                return -1;
+            }
         } else if (OPT("--threads")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &a->threads) != 0 || a->threads > RC_MAX_THREADS)
@@ -222,6 +237,59 @@ static int parse_args(int argc, char **argv, bench_args *a)
         fprintf(stderr, "rangecast bench: note: --pose-count and --seed are ignored with --poses\n");
     return 0;
 }
+
+#if defined(RANGECAST_TOOL_WITH_EMBREE)
+/* --backend embree-single: the plain rtcIntersect1 loop most Embree users write
+ * (tools/rangecast/embree_single.c), timed the same way, printed with the same
+ * keys. Accuracy keys that need triangle ids are null; hit_mismatch counts
+ * escaped rays on the generated sphere. */
+static int bench_embree_single(const bench_args *a, const rcu_mesh *mesh, const rc_pose *poses,
+                               uint32_t pose_count, int is_sphere)
+{
+    const char *cmd = "bench";
+    rcu_preset_rays ref;
+    float *dirs = NULL, *ranges = NULL;
+    double sps = 0.0, build_s = 0.0;
+    uint64_t k, n, escaped = 0, hits = 0;
+    long ncpu = sysconf(_SC_NPROCESSORS_ONLN);
+    uint32_t threads = a->threads ? a->threads : (ncpu > 0 ? (uint32_t)ncpu : 1u);
+    int rc = RCP_EXIT_FAIL;
+    memset(&ref, 0, sizeof ref);
+    if (rcu_preset_rays_f64(a->preset, &ref) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
+    n = (uint64_t)pose_count * ref.rays;
+    dirs = (float *)malloc((size_t)ref.rays * 3 * sizeof(float));
+    ranges = (float *)malloc((size_t)n * sizeof(float));
+    if (!dirs || !ranges) {
+        rcp_fail(cmd, "out of memory for %u scans", pose_count);
+        goto out;
+    }
+    for (k = 0; k < (uint64_t)ref.rays * 3; k++) dirs[k] = (float)ref.dirs[k];
+    if (rct_embree_single_bench(mesh->vertices, mesh->vertex_count, mesh->indices, mesh->triangle_count, dirs,
+                                ref.rays, (float)ref.range_min, (float)ref.range_max, poses, pose_count, threads,
+                                (int)a->repeat, &sps, &build_s, ranges) != 0) {
+        rcp_fail(cmd, "%s", rcu_last_error());
+        goto out;
+    }
+    for (k = 0; k < n; k++) {
+        if (isfinite(ranges[k])) hits++;
+        else escaped++;
+    }
+    printf("{\"tool\":\"rangecast bench\",\"version\":\"%s\",\"backend\":\"embree-single\",\"threads\":%u,"
+           "\"sensor\":\"%s\",\"triangles\":%u,\"poses\":%u,\"rays_per_scan\":%u,\"repeat\":%u,"
+           "\"build_s\":%.6g,\"scans_per_s\":%.6g,\"rays_per_s\":%.6g,\"peak_rss_bytes\":%llu,"
+           "\"hit_fraction\":%.9g,\"hit_mismatch\":",
+           rc_version_string(), threads, a->sensor_name, mesh->triangle_count, pose_count, ref.rays, a->repeat,
+           build_s, sps, sps * ref.rays, (unsigned long long)rcu_peak_rss_bytes(), (double)hits / (double)n);
+    if (is_sphere) printf("%llu}\n", (unsigned long long)escaped);
+    else printf("null}\n");
+    rc = RCP_EXIT_OK;
+out:
+    free(dirs);
+    free(ranges);
+    rcu_preset_rays_free(&ref);
+    return rc;
+}
+#endif
 
 int rcp_cmd_bench(int argc, char **argv)
 {
@@ -283,6 +351,12 @@ int rcp_cmd_bench(int argc, char **argv)
         rcu_poses_random_about(pose_count, BENCH_POSE_RADIUS, a.seed, centre, poses);
     }
 
+#if defined(RANGECAST_TOOL_WITH_EMBREE)
+    if (a.embree_single) {
+        rc = bench_embree_single(&a, &mesh, poses, pose_count, is_sphere);
+        goto done;
+    }
+#endif
     if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) goto done;
     rc_sensor_get_info(w.sensors[0], &si);
     rc_scene_get_info(w.scene, &scinfo);
