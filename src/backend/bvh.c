@@ -1,18 +1,89 @@
 /* The built-in backend: the scene's two-level BVH, traversed on the CPU by the
- * context's thread pool. Work is split into tasks of one pose, or of a slice of
- * a pose's rays when there are fewer poses than threads can keep busy; each ray
- * is computed on its own, so the split never changes a result. */
+ * context's thread pool. Rays of a scan are traced in tiles (neighbouring rows
+ * and columns of a grid sensor, or runs of consecutive O1Dn rays) that share
+ * the sensor's origin, so the packet traversal serves a tile per node fetch.
+ * Work is split into tasks of one pose, or of a slice of a pose's tiles when
+ * there are fewer poses than threads can keep busy. Each ray's answer depends
+ * only on the ray (the packet changes the order of work, not the result), so
+ * the split never changes a bit. */
 #include "backend/backend.h"
+#include "bvh/packet.h"
 
+#include <math.h>
 #include <string.h>
 
-#define MIN_RAYS_PER_TASK 1024u
+#define MIN_TILES_PER_TASK 64u
+
+typedef struct tiling {
+    uint32_t tile_rows, tile_cols;   /* rays a tile spans */
+    uint32_t grid_rows, grid_cols;   /* tiles a scan has */
+} tiling;
 
 typedef struct sim_run {
     const rc__sim_job *job;
-    uint32_t slices;           /* tasks per pose */
-    uint32_t rays_per_slice;
+    tiling tl;
+    uint32_t tiles;                  /* per pose */
+    uint32_t slices;                 /* tasks per pose */
+    uint32_t tiles_per_slice;
+    int packets;                     /* 1 when tiles go through the packet traversal */
 } sim_run;
+
+/* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
+static void choose_tiling(const rc_sensor *s, tiling *tl)
+{
+    double row_step = 1.0, col_step = 1.0, best = 1e300;
+    uint32_t tr;
+    if (s->model == RC_SENSOR_SPHERICAL) {
+        row_step = fabs(s->spherical.phi.increment);
+        col_step = fabs(s->spherical.theta.increment);
+    } else if (s->model == RC_SENSOR_CYLINDRICAL) {
+        row_step = 1.0 / s->cylindrical.fy;
+        col_step = fabs(s->cylindrical.theta.increment);
+    } else if (s->model == RC_SENSOR_PINHOLE) {
+        row_step = 1.0 / s->pinhole.fy;
+        col_step = 1.0 / s->pinhole.fx;
+    } else {
+        row_step = 1e9; /* O1Dn/OnDn: runs of consecutive rays */
+    }
+    tl->tile_rows = 1;
+    for (tr = 1; tr <= RC__PACKET_SIZE; tr *= 2) {
+        uint32_t tc = RC__PACKET_SIZE / tr;
+        double h = tr * (row_step > 0 ? row_step : 1.0), w = tc * (col_step > 0 ? col_step : 1.0);
+        double aspect = h > w ? h / w : w / h;
+        if (tr > s->rows) break;
+        if (aspect < best) {
+            best = aspect;
+            tl->tile_rows = tr;
+        }
+    }
+    tl->tile_cols = RC__PACKET_SIZE / tl->tile_rows;
+    tl->grid_rows = (s->rows + tl->tile_rows - 1) / tl->tile_rows;
+    tl->grid_cols = (s->columns + tl->tile_cols - 1) / tl->tile_cols;
+}
+
+static void world_ray(const rc__xformf *world, const float *ds, const float *os, rc__ray *ray)
+{
+    float org[3], dir[3];
+    rc__rot_apply_f(world->r, ds, dir);
+    if (os) {
+        rc__rot_apply_f(world->r, os, org);
+        org[0] += world->t[0];
+        org[1] += world->t[1];
+        org[2] += world->t[2];
+    } else {
+        org[0] = world->t[0];
+        org[1] = world->t[1];
+        org[2] = world->t[2];
+    }
+    rc__ray_prepare(ray, org, dir);
+}
+
+static void hit_reset(rc__hit *hit, float tmax)
+{
+    hit->t = tmax;
+    hit->u = hit->v = 0.0f;
+    hit->prim = hit->geom = hit->inst = RC_INVALID_ID;
+}
 
 static void trace_task(void *user, uint32_t task, uint32_t thread)
 {
@@ -20,56 +91,63 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
     const rc_scene *scene = job->scene;
+    const tiling *tl = &run->tl;
     uint32_t pose = task / run->slices;
-    uint32_t first = (task % run->slices) * run->rays_per_slice;
-    uint32_t last = first + run->rays_per_slice;
+    uint32_t first = (task % run->slices) * run->tiles_per_slice;
+    uint32_t last = first + run->tiles_per_slice, tile;
     uint64_t base = (uint64_t)pose * sensor->rays;
     rc__xformf world;
-    uint32_t r;
     (void)thread;
-    if (last > sensor->rays) last = sensor->rays;
+    if (last > run->tiles) last = run->tiles;
     rc__sensor_world_xform(sensor, &job->poses[pose], &world);
-    for (r = first; r < last; ++r) {
-        const float *ds = sensor->directions + (size_t)r * 3u;
-        const float *os = sensor->origins ? sensor->origins + (size_t)r * 3u : NULL;
-        float org[3], dir[3];
-        rc__ray ray;
-        rc__hit hit;
-        int found;
-        rc__rot_apply_f(world.r, ds, dir);
-        if (os) {
-            rc__rot_apply_f(world.r, os, org);
-            org[0] += world.t[0];
-            org[1] += world.t[1];
-            org[2] += world.t[2];
-        } else {
-            org[0] = world.t[0];
-            org[1] = world.t[1];
-            org[2] = world.t[2];
+    for (tile = first; tile < last; ++tile) {
+        uint32_t r0 = (tile / tl->grid_cols) * tl->tile_rows, c0 = (tile % tl->grid_cols) * tl->tile_cols;
+        uint32_t idx[RC__PACKET_SIZE];
+        rc__ray rays[RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKET_SIZE];
+        int found[RC__PACKET_SIZE];
+        uint32_t n = 0, a, b, i;
+        for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
+            for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b) idx[n++] = (r0 + a) * sensor->columns + c0 + b;
+        for (i = 0; i < n; ++i) {
+            const float *os = sensor->origins ? sensor->origins + (size_t)idx[i] * 3u : NULL;
+            world_ray(&world, sensor->directions + (size_t)idx[i] * 3u, os, &rays[i]);
+            hit_reset(&hits[i], sensor->range_max);
+            found[i] = 0;
         }
-        rc__ray_prepare(&ray, org, dir);
-        hit.t = sensor->range_max;
-        hit.u = hit.v = 0.0f;
-        hit.prim = hit.geom = hit.inst = RC_INVALID_ID;
-        found = rc__scene_intersect(scene, &ray, &hit);
-        rc__write_result(job, base + r, ds, os, found, &hit, NULL, &world);
+        if (run->packets) {
+            rc__mesh_intersect_packet(&scene->geoms[0].mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+        } else {
+            for (i = 0; i < n; ++i) found[i] = rc__scene_intersect(scene, &rays[i], &hits[i]);
+        }
+        for (i = 0; i < n; ++i) {
+            const float *os = sensor->origins ? sensor->origins + (size_t)idx[i] * 3u : NULL;
+            rc__write_result(job, base + idx[i], sensor->directions + (size_t)idx[i] * 3u, os, found[i], &hits[i],
+                             NULL, &world);
+        }
     }
 }
 
 static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
 {
     sim_run run;
-    uint32_t rays = job->sensor->rays;
     uint32_t threads = ctx->thread_count;
+    const rc_sensor *s = job->sensor;
+    memset(&run, 0, sizeof run);
     run.job = job;
+    choose_tiling(s, &run.tl);
+    run.tiles = run.tl.grid_rows * run.tl.grid_cols;
+    /* Packets need one shared origin and one mesh (the common map); other
+     * scenes go ray by ray through both levels. */
+    run.packets = s->origins == NULL && job->scene->geom_count == 1 && job->scene->inst_count == 0;
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {
         uint32_t want = (threads * 4u + job->pose_count - 1u) / job->pose_count;
-        uint32_t max_slices = rays / MIN_RAYS_PER_TASK;
+        uint32_t max_slices = run.tiles / MIN_TILES_PER_TASK;
         run.slices = want < max_slices ? want : (max_slices ? max_slices : 1u);
     }
-    run.rays_per_slice = (rays + run.slices - 1u) / run.slices;
+    run.tiles_per_slice = (run.tiles + run.slices - 1u) / run.slices;
     rc__pool_run(ctx->pool, job->pose_count * run.slices, trace_task, &run);
     return RC_OK;
 }

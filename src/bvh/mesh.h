@@ -15,6 +15,10 @@ typedef struct rc__mesh {
     uint32_t triangle_count;
     uint32_t reserved0;
     rc__bvh bvh;               /* items are triangle indices */
+    /* The triangles' vertex indices again, in leaf order (3 per bvh.refs
+     * slot), so a leaf's triangles are one contiguous read instead of one
+     * dependent miss each; NULL until the scene's commit fills it. */
+    const uint32_t *leaf_tris;
 } rc__mesh;
 
 /* A ray prepared for traversal: origin, direction (any length, not zero),

@@ -8,6 +8,7 @@
 
 typedef struct accel_layout {
     size_t mesh_nodes, top_nodes, mesh_refs, top_refs; /* capacities (counts) */
+    size_t leaf_tris_offset;                            /* byte offset of the leaf-ordered index triples */
     size_t bytes;                                       /* block payload */
     size_t scratch_items;                               /* largest build */
     size_t scratch_bytes;
@@ -25,8 +26,9 @@ static void layout_of(const rc_scene_desc *d, accel_layout *l)
     l->top_nodes = 2u * items - 1u;
     l->mesh_refs = t;
     l->top_refs = items;
-    l->bytes = align16((l->mesh_nodes + l->top_nodes) * sizeof(rc__bvh_node)) +
-               align16((l->mesh_refs + l->top_refs) * sizeof(uint32_t));
+    l->leaf_tris_offset = align16((l->mesh_nodes + l->top_nodes) * sizeof(rc__bvh_node)) +
+                          align16((l->mesh_refs + l->top_refs) * sizeof(uint32_t));
+    l->bytes = l->leaf_tris_offset + align16(l->mesh_refs * 3u * sizeof(uint32_t));
     l->scratch_items = t > items ? t : items;
     l->scratch_bytes = align16(l->scratch_items * sizeof(rc__aabb)) +
                        rc__bvh_build_scratch_bytes((uint32_t)l->scratch_items);
@@ -57,6 +59,7 @@ void rc__scene_release_bvh(rc_scene *scene)
     memset(&scene->top, 0, sizeof scene->top);
     for (g = 0; g < scene->geom_count; ++g) {
         memset(&scene->geoms[g].mesh.bvh, 0, sizeof scene->geoms[g].mesh.bvh);
+        scene->geoms[g].mesh.leaf_tris = NULL;
         scene->geoms[g].dirty = 1;
     }
 }
@@ -120,7 +123,7 @@ rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *us
     rc__aabb *item_bounds;
     void *builder_scratch;
     rc__bvh_node *nodes;
-    uint32_t *refs;
+    uint32_t *refs, *leaf_tris;
     size_t node_off = 0, ref_off = 0;
     uint32_t g, i, items;
 
@@ -140,6 +143,7 @@ rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *us
     item_bounds = (rc__aabb *)(void *)scratch;
     builder_scratch = scratch + align16(l.scratch_items * sizeof(rc__aabb));
     nodes = (rc__bvh_node *)scene->top_block;
+    leaf_tris = (uint32_t *)(void *)((unsigned char *)scene->top_block + l.leaf_tris_offset);
     refs = (uint32_t *)(void *)((unsigned char *)scene->top_block +
                                 align16((l.mesh_nodes + l.top_nodes) * sizeof(rc__bvh_node)));
 
@@ -152,6 +156,12 @@ rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *us
             rc__mesh_triangle_bounds(&geo->mesh, item_bounds);
             rc__bvh_build(item_bounds, geo->mesh.triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch,
                           &geo->mesh.bvh, progress, user);
+            {
+                uint32_t *lt = leaf_tris + 3u * ref_off, j;
+                for (j = 0; j < geo->mesh.triangle_count; ++j)
+                    memcpy(lt + 3u * j, geo->mesh.indices + 3u * (size_t)geo->mesh.bvh.refs[j], 3 * sizeof(uint32_t));
+                geo->mesh.leaf_tris = lt;
+            }
         } else if (geo->dirty == 2) {
             rc__mesh_triangle_bounds(&geo->mesh, item_bounds);
             rc__bvh_refit(&geo->mesh.bvh, item_bounds);

@@ -1,0 +1,253 @@
+/* Packet traversal over the canonical BVH (see packet.h).
+ *
+ * A packet runs only when all its rays lie in one octant (the same sign of
+ * each direction component), which holds for every tile of a scan but those
+ * that straddle an axis plane. Then each slab's near plane is the same for all
+ * lanes, so a node test is (plane - origin) broadcast times each lane's
+ * reciprocal: 16 lanes cost a few SIMD instructions. Mixed tiles go ray by ray
+ * through the single-ray traversal. Either way every ray gets exactly the hit
+ * rc__mesh_intersect would give it: box tests only choose which triangles are
+ * tested (conservatively), and the triangle test is the same watertight one. */
+#include "bvh/packet.h"
+
+#include "bvh/intersect.h"
+
+#include <float.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#define RC__PACKET_SSE2 1
+#elif defined(__ARM_NEON)
+#include <arm_neon.h>
+#define RC__PACKET_NEON 1
+#endif
+
+#define LANES RC__PACKET_SIZE
+#define GROUPS (LANES / 4u)
+
+typedef struct packet_entry {
+    uint32_t node;
+    uint32_t mask; /* lanes that met this node's box when it was pushed */
+} packet_entry;
+
+/* Per-lane slab data, 16-byte aligned rows of 4 lanes. */
+typedef struct packet_lanes {
+    float ix[LANES], iy[LANES], iz[LANES];
+    float tmax[LANES];
+    uint32_t near_off[3];  /* byte offset of the near plane per axis: 0 (bmin) or 16 (bmax) */
+    float org[3];
+} packet_lanes;
+
+#if defined(__GNUC__)
+#define RC__ALIGN16 __attribute__((aligned(16)))
+#else
+#define RC__ALIGN16
+#endif
+
+/* Lanes of `mask` whose ray meets the box within [0, tmax]; *tmin_out gets a
+ * lower bound of their entry distances (for ordering only). */
+static inline uint32_t box_mask(const rc__bvh_node *n, const packet_lanes *L, uint32_t mask, float *tmin_out)
+{
+    const float nx = rc__node_plane(n, L->near_off[0]) - L->org[0];
+    const float ny = rc__node_plane(n, L->near_off[1]) - L->org[1];
+    const float nz = rc__node_plane(n, L->near_off[2]) - L->org[2];
+    const float fx = rc__node_plane(n, L->near_off[0] ^ 16u) - L->org[0];
+    const float fy = rc__node_plane(n, L->near_off[1] ^ 16u) - L->org[1];
+    const float fz = rc__node_plane(n, L->near_off[2] ^ 16u) - L->org[2];
+    uint32_t out = 0, g;
+#if defined(RC__PACKET_SSE2)
+    const __m128 vnx = _mm_set1_ps(nx), vny = _mm_set1_ps(ny), vnz = _mm_set1_ps(nz);
+    const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy), vfz = _mm_set1_ps(fz);
+    const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
+    __m128 best = _mm_set1_ps(FLT_MAX);
+    for (g = 0; g < GROUPS; ++g) {
+        const __m128 ix = _mm_load_ps(L->ix + 4 * g), iy = _mm_load_ps(L->iy + 4 * g);
+        const __m128 iz = _mm_load_ps(L->iz + 4 * g);
+        /* max/min return their second operand when the first is NaN: a NaN
+         * (0 * inf, origin on a plane of a parallel ray) imposes nothing */
+        __m128 t0 = _mm_max_ps(_mm_mul_ps(vnx, ix), _mm_setzero_ps());
+        __m128 t1 = _mm_min_ps(_mm_mul_ps(vfx, ix), _mm_load_ps(L->tmax + 4 * g));
+        t0 = _mm_max_ps(_mm_mul_ps(vny, iy), t0);
+        t0 = _mm_max_ps(_mm_mul_ps(vnz, iz), t0);
+        t1 = _mm_min_ps(_mm_mul_ps(vfy, iy), t1);
+        t1 = _mm_min_ps(_mm_mul_ps(vfz, iz), t1);
+        {
+            const __m128 h = _mm_cmple_ps(t0, _mm_mul_ps(t1, scale));
+            out |= (uint32_t)_mm_movemask_ps(h) << (4 * g);
+            best = _mm_min_ps(best, _mm_or_ps(_mm_and_ps(h, t0), _mm_andnot_ps(h, _mm_set1_ps(FLT_MAX))));
+        }
+    }
+    {
+        float b[4] RC__ALIGN16;
+        _mm_store_ps(b, best);
+        b[0] = b[0] < b[1] ? b[0] : b[1];
+        b[2] = b[2] < b[3] ? b[2] : b[3];
+        *tmin_out = b[0] < b[2] ? b[0] : b[2];
+    }
+#elif defined(RC__PACKET_NEON)
+    const float32x4_t vnx = vdupq_n_f32(nx), vny = vdupq_n_f32(ny), vnz = vdupq_n_f32(nz);
+    const float32x4_t vfx = vdupq_n_f32(fx), vfy = vdupq_n_f32(fy), vfz = vdupq_n_f32(fz);
+    const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE), big = vdupq_n_f32(FLT_MAX);
+    float32x4_t best = big;
+    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
+    const uint32x4_t vbits = vld1q_u32(bits);
+    for (g = 0; g < GROUPS; ++g) {
+        const float32x4_t ix = vld1q_f32(L->ix + 4 * g), iy = vld1q_f32(L->iy + 4 * g);
+        const float32x4_t iz = vld1q_f32(L->iz + 4 * g);
+        float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(L->tmax + 4 * g), a;
+        uint32x4_t h;
+        /* "a > b ? a : b" (NEON's max would propagate a NaN) */
+        a = vmulq_f32(vnx, ix);
+        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+        a = vmulq_f32(vny, iy);
+        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+        a = vmulq_f32(vnz, iz);
+        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+        a = vmulq_f32(vfx, ix);
+        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+        a = vmulq_f32(vfy, iy);
+        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+        a = vmulq_f32(vfz, iz);
+        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+        h = vcleq_f32(t0, vmulq_f32(t1, scale));
+        {
+            uint32x4_t m = vandq_u32(h, vbits);
+            uint32x2_t s2 = vorr_u32(vget_low_u32(m), vget_high_u32(m));
+            out |= (vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1)) << (4 * g);
+        }
+        best = vminq_f32(best, vbslq_f32(h, t0, big));
+    }
+    {
+        float32x2_t m2 = vmin_f32(vget_low_f32(best), vget_high_f32(best));
+        float a0 = vget_lane_f32(m2, 0), a1 = vget_lane_f32(m2, 1);
+        *tmin_out = a0 < a1 ? a0 : a1;
+    }
+#else
+    {
+        float best = FLT_MAX;
+        for (g = 0; g < LANES; ++g) {
+            const float ax = nx * L->ix[g], ay = ny * L->iy[g], az = nz * L->iz[g];
+            const float bx = fx * L->ix[g], by = fy * L->iy[g], bz = fz * L->iz[g];
+            float t0 = 0.0f, t1 = L->tmax[g];
+            t0 = ax > t0 ? ax : t0;
+            t0 = ay > t0 ? ay : t0;
+            t0 = az > t0 ? az : t0;
+            t1 = bx < t1 ? bx : t1;
+            t1 = by < t1 ? by : t1;
+            t1 = bz < t1 ? bz : t1;
+            if (t0 <= t1 * RC__SLAB_FAR_SCALE) {
+                out |= 1u << g;
+                if (t0 < best) best = t0;
+            }
+        }
+        *tmin_out = best;
+    }
+#endif
+    return out & mask;
+}
+
+/* 1 when every ray of the packet has the same direction signs (by the sign of
+ * its reciprocal, so -0 counts as negative, as in the single-ray test). */
+static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_off[3])
+{
+    uint32_t i, k;
+    for (k = 0; k < 3; ++k) {
+        const int neg = rays[0].inv_dir[k] < 0.0f;
+        for (i = 1; i < n; ++i)
+            if ((rays[i].inv_dir[k] < 0.0f) != neg) return 0;
+        near_off[k] = 4u * k + (neg ? 16u : 0u); /* bmin at 0, bmax at 16 */
+    }
+    return 1;
+}
+
+void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
+                               uint32_t inst, rc__hit *hits, int *found)
+{
+    const rc__bvh_node *nodes = mesh->bvh.nodes;
+    const uint32_t *refs = mesh->bvh.refs;
+    const uint32_t *indices = mesh->indices;
+    const uint32_t *leaf_tris = mesh->leaf_tris;
+    const float *vertices = mesh->vertices;
+    const size_t stride = mesh->stride;
+    packet_lanes L RC__ALIGN16;
+    packet_entry stack[RC__BVH_MAX_DEPTH + 1];
+    uint32_t sp = 0, i, node = 0, mask;
+    float tdummy;
+
+    if (n == 0 || mesh->bvh.node_count == 0) return;
+    if (n > LANES || !one_octant(rays, n, L.near_off)) {
+        for (i = 0; i < n; ++i) found[i] |= rc__mesh_intersect(mesh, &rays[i], geom, inst, &hits[i]);
+        return;
+    }
+    for (i = 0; i < 3; ++i) L.org[i] = rays[0].org[i];
+    for (i = 0; i < LANES; ++i) {
+        const rc__ray *r = &rays[i < n ? i : 0];
+        L.ix[i] = r->inv_dir[0];
+        L.iy[i] = r->inv_dir[1];
+        L.iz[i] = r->inv_dir[2];
+        L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
+    }
+    mask = box_mask(&nodes[0], &L, (n >= 32u ? 0u : (1u << n)) - 1u, &tdummy);
+    while (mask) {
+        const rc__bvh_node *nd = &nodes[node];
+        if (nd->count == 0) {
+            float t0, t1;
+            const uint32_t m0 = box_mask(&nodes[nd->index], &L, mask, &t0);
+            const uint32_t m1 = box_mask(&nodes[nd->index + 1], &L, mask, &t1);
+            if (m0 && m1) {
+                /* nearer child first (by the packet's smallest entry) */
+                if (t1 < t0) {
+                    stack[sp].node = nd->index;
+                    stack[sp].mask = m0;
+                    node = nd->index + 1;
+                    mask = m1;
+                } else {
+                    stack[sp].node = nd->index + 1;
+                    stack[sp].mask = m1;
+                    node = nd->index;
+                    mask = m0;
+                }
+                ++sp; /* depth is capped by the builder */
+                continue;
+            }
+            if (m0 | m1) {
+                node = m0 ? nd->index : nd->index + 1;
+                mask = m0 | m1;
+                continue;
+            }
+        } else {
+            const uint32_t end = nd->index + nd->count;
+            uint32_t j;
+            for (j = nd->index; j < end; ++j) {
+                const uint32_t prim = refs[j];
+                const uint32_t *tri = leaf_tris ? leaf_tris + (size_t)3 * j : indices + (size_t)3 * prim;
+                const float *a = vertices + tri[0] * stride, *b = vertices + tri[1] * stride;
+                const float *c = vertices + tri[2] * stride;
+                uint32_t m = mask;
+                while (m) {
+                    uint32_t lane = 0;
+                    float t, u, v;
+                    while (!((m >> lane) & 1u)) ++lane;
+                    m &= m - 1u;
+                    if (!rc__tri_intersect(&rays[lane], a, b, c, &t, &u, &v)) continue;
+                    if (t > hits[lane].t) continue;
+                    if (t == hits[lane].t && !rc__hit_key_less(inst, geom, prim, &hits[lane])) continue;
+                    hits[lane].t = t;
+                    hits[lane].u = u;
+                    hits[lane].v = v;
+                    hits[lane].prim = prim;
+                    hits[lane].geom = geom;
+                    hits[lane].inst = inst;
+                    L.tmax[lane] = t;
+                    found[lane] = 1;
+                }
+            }
+        }
+        /* pop, dropping entries all of whose lanes have since found nearer hits
+         * is left to the box tests below them (tmax per lane) */
+        if (sp == 0) break;
+        --sp;
+        node = stack[sp].node;
+        mask = stack[sp].mask;
+    }
+}

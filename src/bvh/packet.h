@@ -1,0 +1,21 @@
+/* Coherent traversal: up to RC__PACKET_SIZE rays that share one origin (a tile
+ * of a scan) walk the mesh BVH together. Each node is fetched once for the
+ * packet and its box tested against every active ray in fixed-width loops the
+ * compiler turns into SIMD (SSE on x86-64, NEON on ARM); leaves run the same
+ * watertight test as single rays, per active ray. Every ray gets exactly the
+ * hit rc__mesh_intersect would give it: the packet changes the order of work,
+ * not the answer. */
+#ifndef RC_BVH_PACKET_H
+#define RC_BVH_PACKET_H
+
+#include "bvh/mesh.h"
+
+#define RC__PACKET_SIZE 16u
+
+/* rays[0..n) must share org (only rays[0].org is read for the box tests).
+ * hits[i].t holds ray i's tmax on entry; found[i] is set to 1 where a hit was
+ * recorded (found[] is not cleared). */
+void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
+                               uint32_t inst, rc__hit *hits, int *found);
+
+#endif
