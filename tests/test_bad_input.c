@@ -96,6 +96,17 @@ static void test_simulate_bad_input(void **state)
     EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 2, &r), RC_ERR_INVALID_ARGUMENT, "unit");
     poses[1].orientation[3] = 0.0f; /* zero quaternion */
     EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 2, &r), RC_ERR_INVALID_ARGUMENT, "unit");
+    {
+        rc_pose_d pd[1];
+        memset(pd, 0, sizeof pd);
+        pd[0].orientation[3] = 1.0;
+        pd[0].position[0] = INFINITY;
+        EXPECT_FAIL(f, rc_simulate_d(f->ctx, f->scene, f->sensor, pd, 1, &r), RC_ERR_NON_FINITE, "poses[0]");
+        EXPECT_FAIL(f, rc_simulate_d(f->ctx, f->scene, f->sensor, NULL, 1, &r), RC_ERR_INVALID_ARGUMENT, "poses");
+        pd[0].position[0] = 0.0;
+        pd[0].orientation[3] = 0.9;
+        EXPECT_FAIL(f, rc_simulate_d(f->ctx, f->scene, f->sensor, pd, 1, &r), RC_ERR_INVALID_ARGUMENT, "unit");
+    }
     /* near-unit quaternions are normalised and accepted */
     poses[1].orientation[3] = 1.0005f;
     RCT_OK(f->ctx, rc_simulate(f->ctx, f->scene, f->sensor, poses, 2, &r));
@@ -187,6 +198,10 @@ static void test_scene_desc_bad_input(void **state)
     sd.flags = 0;
     sd.max_triangles = (uint64_t)1 << 40;
     EXPECT_FAIL(f, rc_scene_memory_requirements(f->ctx, &sd, &bytes), RC_ERR_INVALID_ARGUMENT, "max_triangles");
+    sd.max_triangles = 10;
+    sd.origin[1] = NAN;
+    EXPECT_FAIL(f, rc_scene_create(f->ctx, &sd, &s), RC_ERR_NON_FINITE, "origin");
+    sd.origin[1] = 0.0;
     sd.max_triangles = (uint64_t)1 << 26;
     sd.max_vertices = (uint64_t)1 << 26; /* 768 MiB of vertex copies do not fit in 16 MiB */
     EXPECT_FAIL(f, rc_scene_create(f->ctx, &sd, &s), RC_ERR_OUT_OF_MEMORY, "arena");

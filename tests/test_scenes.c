@@ -568,6 +568,77 @@ static void test_pinhole_wall(void **state)
     rc_context_destroy(ctx);
 }
 
+
+/* A room far from the origin (UTM-like map coordinates): the scene's origin is
+ * the room's corner, vertices are local, poses are double map coordinates.
+ * Ranges stay within a micrometre-scale error at every offset up to 1e6 m. */
+static void test_far_from_origin(void **state)
+{
+    uint32_t b = backend_of(state);
+    static const double offsets[4] = {1e3, 1e4, 1e5, 1e6};
+    const float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {12.0f, 8.0f, 3.0f};
+    rcu_mesh m;
+    float dirs[3 * 8];
+    uint32_t k, i;
+    NEED_BACKEND(b);
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    for (i = 0; i < 8; ++i) {
+        double a = i * 0.785398163397448;
+        dirs[3 * i] = (float)cos(a);
+        dirs[3 * i + 1] = (float)sin(a);
+        dirs[3 * i + 2] = 0.1f;
+    }
+    for (k = 0; k < 4; ++k) {
+        rc_context *ctx = rct_context(b, 1, 0);
+        rc_scene_desc sd = rc_scene_desc_default();
+        rc_mesh_desc md = rc_mesh_desc_default();
+        rc_scene *scene;
+        rc_sensor *sensor;
+        rct_buffers buf;
+        rc_pose_d pose;
+        uint32_t g;
+        const double o[3] = {offsets[k] + 0.123, offsets[k] * 0.5 + 0.456, 30.0};
+        sd.max_triangles = m.triangle_count;
+        sd.origin[0] = o[0];
+        sd.origin[1] = o[1];
+        sd.origin[2] = o[2];
+        RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+        md.vertices = m.vertices;
+        md.vertex_count = m.vertex_count;
+        md.indices = m.indices;
+        md.triangle_count = m.triangle_count;
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+        RCT_OK(ctx, rc_scene_commit(scene));
+        sensor = rct_sensor_dirs(ctx, dirs, 8, 0.1f, 100.0f);
+        memset(&pose, 0, sizeof pose);
+        pose.position[0] = o[0] + 4.0000005; /* sub-millimetre parts must survive */
+        pose.position[1] = o[1] + 3.0000007;
+        pose.position[2] = o[2] + 1.0;
+        pose.orientation[3] = 1.0;
+        rct_buffers_alloc(&buf, 8, RC_ATTR_RANGES | RC_ATTR_HITS);
+        RCT_OK(ctx, rc_simulate_d(ctx, scene, sensor, &pose, 1, &buf.res));
+        for (i = 0; i < 8; ++i) {
+            const double p[3] = {4.0000005, 3.0000007, 1.0};
+            double d[3], len, expect;
+            int axis = -1;
+            d[0] = dirs[3 * i];
+            d[1] = dirs[3 * i + 1];
+            d[2] = dirs[3 * i + 2];
+            len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+            d[0] /= len;
+            d[1] /= len;
+            d[2] /= len;
+            expect = box_exit(p, d, lo, hi, &axis);
+            assert_int_equal(buf.res.hits[i], 1);
+            if (fabs(buf.res.ranges[i] - expect) > 1e-5)
+                fail_msg("offset %g ray %u: range %.7f expected %.7f", offsets[k], i, (double)buf.res.ranges[i], expect);
+        }
+        rct_buffers_free(&buf);
+        rc_context_destroy(ctx);
+    }
+    rcu_mesh_free(&m);
+}
+
 #define FOR_BACKENDS(f)                                            \
     cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),        \
         cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),    \
@@ -581,6 +652,7 @@ int main(void)
         FOR_BACKENDS(test_instances),         FOR_BACKENDS(test_watertight),
         FOR_BACKENDS(test_thread_independence), FOR_BACKENDS(test_only_requested_attributes),
         FOR_BACKENDS(test_coplanar_tie),      FOR_BACKENDS(test_pinhole_wall),
+        FOR_BACKENDS(test_far_from_origin),
     };
     return cmocka_run_group_tests_name("scenes (every backend)", tests, NULL, NULL);
 }

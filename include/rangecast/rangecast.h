@@ -130,6 +130,12 @@ typedef struct rc_pose {
     float orientation[4]; /* x, y, z, w */
 } rc_pose;
 
+/* The same in double, for map coordinates far from the origin (UTM). */
+typedef struct rc_pose_d {
+    double position[3];
+    double orientation[4]; /* x, y, z, w */
+} rc_pose_d;
+
 /* Identity pose (0,0,0; 0,0,0,1). Thread-safe. */
 RC_API rc_pose rc_pose_identity(void);
 
@@ -247,6 +253,13 @@ typedef struct rc_scene_desc {
     uint64_t max_triangles;    /* sum of triangles over all its meshes */
     uint64_t max_vertices;     /* sum of vertices over meshes added with RC_MESH_COPY */
     uint64_t max_copied_triangles; /* sum of triangles over meshes added with RC_MESH_COPY */
+    /* Map coordinates of the scene's (0, 0, 0). Vertices are given relative to
+     * it (float keeps millimetres only within a few km of its origin), poses
+     * in map coordinates: simulate subtracts the origin in double before
+     * casting rays in float. For UTM-scale maps set it to the map's centre and
+     * pass poses with rc_simulate_d. Must be finite; 0 for ordinary maps.
+     * Used only when this scene is the one simulated (not as an instance). */
+    double origin[3];
     uint32_t reserved[8];
 } rc_scene_desc;
 
@@ -546,6 +559,11 @@ RC_API rc_results rc_results_default(void);
  * threads; results are bit-identical for any thread count. No allocation. */
 RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
                              const rc_pose *poses, uint32_t pose_count, const rc_results *results);
+
+/* rc_simulate with double-precision poses (map coordinates far from the
+ * origin, see rc_scene_desc.origin). Same checks, statuses and results. */
+RC_API rc_status rc_simulate_d(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
+                               const rc_pose_d *poses, uint32_t pose_count, const rc_results *results);
 
 #ifdef __cplusplus
 }

@@ -58,6 +58,9 @@ static rc_status check_scene_desc(rc_context *ctx, const rc_scene_desc *desc)
                  (unsigned long long)desc->max_vertices);
     RC_RETURN_IF(ctx, desc->max_triangles == 0 && desc->max_instances == 0, RC_ERR_INVALID_ARGUMENT,
                  "desc->max_triangles and desc->max_instances are both 0: the scene could hold nothing");
+    RC_RETURN_IF(ctx, !isfinite(desc->origin[0]) || !isfinite(desc->origin[1]) || !isfinite(desc->origin[2]),
+                 RC_ERR_NON_FINITE, "desc->origin is (%g, %g, %g): not finite", desc->origin[0], desc->origin[1],
+                 desc->origin[2]);
     RC_RETURN_IF(ctx, desc->max_instances > 0x00FFFFFFu || desc->max_geometries > 0x00FFFFFFu,
                  RC_ERR_INVALID_ARGUMENT, "desc->max_geometries/max_instances above 16777215");
     return RC_OK;

@@ -18,8 +18,8 @@ static rc_status check_buffer(rc_context *ctx, uint32_t attributes, uint32_t bit
     return RC_OK;
 }
 
-rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
-                      uint32_t pose_count, const rc_results *results)
+static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
+                         const rc_pose_d *poses_d, uint32_t pose_count, const rc_results *results)
 {
     rc__sim_job job;
     uint64_t need;
@@ -32,7 +32,7 @@ rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *s
     RC_RETURN_IF(ctx, sensor->ctx != ctx, RC_ERR_INVALID_ARGUMENT, "sensor belongs to another context");
     RC_RETURN_IF(ctx, !rc__scene_up_to_date(scene), RC_ERR_NOT_COMMITTED,
                  "scene is not committed (or it, or a scene it instances, changed since): call rc_scene_commit");
-    RC_RETURN_IF(ctx, poses == NULL, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
+    RC_RETURN_IF(ctx, poses == NULL && poses_d == NULL, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
     RC_RETURN_IF(ctx, pose_count == 0, RC_ERR_INVALID_ARGUMENT, "pose_count is 0");
     RC_TRY(rc__check_desc(ctx, results, (uint32_t)sizeof *results, (uint32_t)sizeof *results, "results"));
     RC_TRY(rc__check_reserved(ctx, results->reserved, 8, "results"));
@@ -52,7 +52,7 @@ rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *s
                  "results->capacity is %llu; %u poses x %u rays need %llu", (unsigned long long)results->capacity,
                  (unsigned)pose_count, (unsigned)sensor->rays, (unsigned long long)need);
     for (i = 0; i < pose_count; ++i) {
-        rc_status st = rc__pose_check(&poses[i]);
+        rc_status st = poses ? rc__pose_check(&poses[i]) : rc__pose_check_d(&poses_d[i]);
         RC_RETURN_IF(ctx, st == RC_ERR_NON_FINITE, st, "poses[%u] has a NaN or infinite value", (unsigned)i);
         RC_RETURN_IF(ctx, st != RC_OK, st,
                      "poses[%u].orientation is not a unit quaternion (|q| = 1 within 1e-3 is normalised; "
@@ -62,8 +62,29 @@ rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *s
     job.scene = scene;
     job.sensor = sensor;
     job.poses = poses;
+    job.poses_d = poses_d;
     job.pose_count = pose_count;
     job.attributes = a;
     job.out = results;
     return ctx->backend->simulate(ctx, &job);
+}
+
+rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
+                      uint32_t pose_count, const rc_results *results)
+{
+    if (!poses && rc__context_valid(ctx)) {
+        rc__clear_error(ctx);
+        return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
+    }
+    return simulate(ctx, scene, sensor, poses, NULL, pose_count, results);
+}
+
+rc_status rc_simulate_d(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose_d *poses,
+                        uint32_t pose_count, const rc_results *results)
+{
+    if (!poses && rc__context_valid(ctx)) {
+        rc__clear_error(ctx);
+        return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
+    }
+    return simulate(ctx, scene, sensor, NULL, poses, pose_count, results);
 }

@@ -13,7 +13,8 @@
 typedef struct rc__sim_job {
     const rc_scene *scene;
     const rc_sensor *sensor;
-    const rc_pose *poses;      /* checked: finite, near-unit quaternions */
+    const rc_pose *poses;      /* checked: finite, near-unit quaternions; NULL when poses_d is set */
+    const rc_pose_d *poses_d;  /* double poses (rc_simulate_d), else NULL */
     uint32_t pose_count;
     uint32_t attributes;       /* RC_ATTR_* */
     const rc_results *out;
@@ -42,8 +43,12 @@ const rc__backend *rc__backend_find(uint32_t id);
 
 extern const rc__backend rc__backend_bvh;
 
-/* Per-pose transform sensor -> map: pose * mount. */
+/* Per-pose transform sensor -> map: pose * mount (float pose, no scene origin). */
 void rc__sensor_world_xform(const rc_sensor *sensor, const rc_pose *pose, rc__xformf *out);
+/* Sensor -> scene frame of pose i of a job: pose (float or double) * mount,
+ * minus the scene's origin, composed in double and then cast. Every backend
+ * uses this, so far-from-origin maps keep float precision everywhere. */
+void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out);
 
 /* Writes every requested attribute of element k from a hit (or none).
  * dir_s / org_s: the ray in the sensor frame (unit dir). hit->t is the range.

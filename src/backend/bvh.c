@@ -99,7 +99,7 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     rc__xformf world;
     (void)thread;
     if (last > run->tiles) last = run->tiles;
-    rc__sensor_world_xform(sensor, &job->poses[pose], &world);
+    rc__job_world_xform(job, pose, &world);
     for (tile = first; tile < last; ++tile) {
         uint32_t r0 = (tile / tl->grid_cols) * tl->tile_rows, c0 = (tile % tl->grid_cols) * tl->tile_cols;
         uint32_t idx[RC__PACKET_SIZE];
@@ -140,6 +140,9 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     /* Packets need one shared origin and one mesh (the common map); other
      * scenes go ray by ray through both levels. */
     run.packets = s->origins == NULL && job->scene->geom_count == 1 && job->scene->inst_count == 0;
+#if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
+    run.packets = 0;
+#endif
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {

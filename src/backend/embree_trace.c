@@ -206,7 +206,7 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     uint32_t t;
     (void)thread;
     if (last > run->tiles_per_pose) last = run->tiles_per_pose;
-    rc__sensor_world_xform(job->sensor, &job->poses[pose], &world);
+    rc__job_world_xform(job, pose, &world);
     rc__rtc_query_init(&q, run->coherent);
     switch (run->width) {
     case 16:

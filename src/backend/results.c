@@ -13,6 +13,21 @@ void rc__sensor_world_xform(const rc_sensor *sensor, const rc_pose *pose, rc__xf
     rc__xform_to_float(&world, out);
 }
 
+void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out)
+{
+    rc__xform base, world;
+    if (job->poses_d) {
+        rc__xform_from_pose_d(&job->poses_d[pose], &base);
+    } else {
+        rc__xform_from_pose(&job->poses[pose], &base);
+    }
+    rc__xform_mul(&base, &job->sensor->mount_xform, &world);
+    world.t[0] -= job->scene->desc.origin[0];
+    world.t[1] -= job->scene->desc.origin[1];
+    world.t[2] -= job->scene->desc.origin[2];
+    rc__xform_to_float(&world, out);
+}
+
 void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s, int found,
                       const rc__hit *hit, const float n_world_in[3], const rc__xformf *world)
 {

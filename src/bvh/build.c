@@ -285,10 +285,10 @@ static int rc__choose_split(rc__builder *b, const rc__task *t, float scale[3], u
     if (nb < 2) nb = 2;
     last = (float)(nb - 1);
     for (i = 0; i < 3; ++i) {
-        float e = t->cmax[i] - t->cmin[i];
-        scale[i] = (float)nb * (1.0f - 1.0f / 65536.0f) / e;
+        const float e = t->cmax[i] - t->cmin[i];
+        scale[i] = e > 0.0f ? (float)nb * (1.0f - 1.0f / 65536.0f) / e : 0.0f;
         valid[i] = e > 0.0f && scale[i] < INFINITY && scale[i] > 0.0f;
-        if (!valid[i]) scale[i] = 0.0f; /* binned anyway, into bin 0; never used */
+        if (!valid[i]) scale[i] = 0.0f; /* binned anyway; never used */
     }
     if (valid[0] | valid[1] | valid[2]) {
         rc__bin *b0 = b->bins[0], *b1 = b->bins[1], *b2 = b->bins[2];

@@ -13,9 +13,12 @@
  *  - every edge function has the form E(P,Q) = Qx*Py - Qy*Px, so the edge
  *    shared by two triangles (walked in opposite directions) gives exactly
  *    -E in the other triangle. That only holds when the compiler does not fuse
- *    a product and the subtraction into an FMA: compile with FP contraction off
- *    (GCC's default for -std=c99; clang needs the pragma below; GCC in gnu99
- *    mode on FMA targets needs -ffp-contract=off).
+ *    a product and the subtraction into an FMA. FP contraction is off in GCC's
+ *    -std=c99 mode, the pragma below turns clang's off, and each product has a
+ *    second use (the zero test) so GCC does not fuse it even in gnu99 mode on
+ *    FMA targets (checked on aarch64). -ffp-contract=fast in clang overrides
+ *    the pragma: build the library with -ffp-contract=off to be sure, which
+ *    also keeps t bit-identical between code paths.
  * Exactly zero edge functions are recomputed in double (products of floats are
  * exact there), which settles rays through edges and vertices consistently. */
 #ifndef RC_BVH_INTERSECT_H
@@ -24,6 +27,7 @@
 #include "bvh/mesh.h"
 
 #include <float.h>
+#include <stddef.h>
 
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT OFF
@@ -33,11 +37,15 @@
  * so rounding in (plane - org) * inv_dir can never reject a box the ray meets. */
 #define RC__SLAB_FAR_SCALE (1.0f + 4.0f * FLT_EPSILON)
 
-/* Per-ray constants of the slab test. */
+/* Per-ray constants of the slab test. A node is read as it is laid out
+ * (bmin[3], index, bmax[3], count): for each axis, the plane the ray enters by
+ * (bmin where the direction is positive, bmax where it is negative, -0.0
+ * included) is at byte offset near[k] of the node and the one it leaves by at
+ * near[k] ^ 16, so no per-node choice is needed. */
 typedef struct rc__slab_ray {
     float org[3];
     float inv[3];
-    int neg[3]; /* 1 where inv_dir < 0 (including -0.0 directions): the ray enters by bmax */
+    uint32_t near[3];
     float tmin; /* 0: where intervals start */
 } rc__slab_ray;
 
@@ -47,27 +55,37 @@ static inline void rc__slab_ray_init(rc__slab_ray *s, const rc__ray *ray)
     for (k = 0; k < 3; ++k) {
         s->org[k] = ray->org[k];
         s->inv[k] = ray->inv_dir[k];
-        s->neg[k] = ray->inv_dir[k] < 0.0f;
+        s->near[k] = (uint32_t)(offsetof(rc__bvh_node, bmin) + sizeof(float) * (size_t)k);
+        if (ray->inv_dir[k] < 0.0f) s->near[k] += (uint32_t)offsetof(rc__bvh_node, bmax);
     }
     s->tmin = 0.0f;
 }
 
-/* 1 when the ray meets the node's box within [0, tmax] (conservatively);
- * *tnear gets the entry distance (>= 0). negx/y/z are s->neg; traversals that
- * specialise on the ray's octant pass constants so the plane choice folds away.
- * A zero direction component gives an infinite reciprocal, and a NaN (0 * inf)
- * where the origin lies exactly on a plane: the comparisons below are written
- * so a NaN never replaces the running value, i.e. that plane imposes nothing
- * (the box is closed). An empty box (min = +inf, max = -inf) is always missed. */
-static inline int rc__node_hit_octant(const rc__bvh_node *n, const rc__slab_ray *s, float tmax,
-                                      float *tnear, int negx, int negy, int negz)
+/* rc__node_hit reads planes by byte offset: bmin at 0, bmax at 16. */
+typedef char rc__node_layout_check[(offsetof(rc__bvh_node, bmin) == 0 &&
+                                    offsetof(rc__bvh_node, bmax) == 16 &&
+                                    sizeof(rc__bvh_node) == 32) ? 1 : -1];
+
+/* The bmin/bmax component at byte offset off of a node. */
+static inline float rc__node_plane(const rc__bvh_node *n, uint32_t off)
 {
-    const float nx = ((negx ? n->bmax[0] : n->bmin[0]) - s->org[0]) * s->inv[0];
-    const float ny = ((negy ? n->bmax[1] : n->bmin[1]) - s->org[1]) * s->inv[1];
-    const float nz = ((negz ? n->bmax[2] : n->bmin[2]) - s->org[2]) * s->inv[2];
-    const float fx = ((negx ? n->bmin[0] : n->bmax[0]) - s->org[0]) * s->inv[0];
-    const float fy = ((negy ? n->bmin[1] : n->bmax[1]) - s->org[1]) * s->inv[1];
-    const float fz = ((negz ? n->bmin[2] : n->bmax[2]) - s->org[2]) * s->inv[2];
+    return *(const float *)(const void *)((const unsigned char *)n + off);
+}
+
+/* 1 when the ray meets the node's box within [0, tmax] (conservatively);
+ * *tnear gets the entry distance (>= 0). A zero direction component gives an
+ * infinite reciprocal, and a NaN (0 * inf) where the origin lies exactly on a
+ * plane: the comparisons below are written so a NaN never replaces the running
+ * value, i.e. that plane imposes nothing (the box is closed). An empty box
+ * (min = +inf, max = -inf) is always missed. */
+static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, float tmax, float *tnear)
+{
+    const float nx = (rc__node_plane(n, s->near[0]) - s->org[0]) * s->inv[0];
+    const float ny = (rc__node_plane(n, s->near[1]) - s->org[1]) * s->inv[1];
+    const float nz = (rc__node_plane(n, s->near[2]) - s->org[2]) * s->inv[2];
+    const float fx = (rc__node_plane(n, s->near[0] ^ 16u) - s->org[0]) * s->inv[0];
+    const float fy = (rc__node_plane(n, s->near[1] ^ 16u) - s->org[1]) * s->inv[1];
+    const float fz = (rc__node_plane(n, s->near[2] ^ 16u) - s->org[2]) * s->inv[2];
     float tn = s->tmin, tf = tmax;
     /* a > b ? a : b keeps b when a is NaN; b is never NaN */
     tn = nx > tn ? nx : tn;
@@ -80,36 +98,39 @@ static inline int rc__node_hit_octant(const rc__bvh_node *n, const rc__slab_ray 
     return tn <= tf * RC__SLAB_FAR_SCALE;
 }
 
-static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, float tmax, float *tnear)
-{
-    return rc__node_hit_octant(n, s, tmax, tnear, s->neg[0], s->neg[1], s->neg[2]);
-}
-
+/* RC__COLD: a rarely taken path kept out of line (and no warning where a
+ * file includes this header without using it). */
 #if defined(__GNUC__)
-#define RC__NOINLINE __attribute__((noinline, unused))
+#define RC__COLD static __attribute__((noinline, unused))
 #define RC__FORCE_INLINE inline __attribute__((always_inline))
 #else
-#define RC__NOINLINE
+#define RC__COLD static inline
 #define RC__FORCE_INLINE inline
 #endif
 
+/* double to float without overflow (huge coordinates). */
+static inline float rc__clamp_to_float(double d)
+{
+    return d > FLT_MAX ? FLT_MAX : d < -FLT_MAX ? -FLT_MAX : (float)d;
+}
+
 /* Exactly zero edge function(s): recompute all three in double. */
-static RC__NOINLINE void rc__tri_edges_double(float Ax, float Ay, float Bx, float By, float Cx,
-                                              float Cy, float *U, float *V, float *W)
+RC__COLD void rc__tri_edges_double(float Ax, float Ay, float Bx, float By, float Cx, float Cy,
+                                   float *U, float *V, float *W)
 {
     const double CxBy = (double)Cx * (double)By, CyBx = (double)Cy * (double)Bx;
     const double AxCy = (double)Ax * (double)Cy, AyCx = (double)Ay * (double)Cx;
     const double BxAy = (double)Bx * (double)Ay, ByAx = (double)By * (double)Ax;
-    *U = (float)(CxBy - CyBx);
-    *V = (float)(AxCy - AyCx);
-    *W = (float)(BxAy - ByAx);
+    *U = rc__clamp_to_float(CxBy - CyBx);
+    *V = rc__clamp_to_float(AxCy - AyCx);
+    *W = rc__clamp_to_float(BxAy - ByAx);
 }
 
 /* 1 when (b - a) x (c - a) is exactly zero (to double precision): a zero-area
  * triangle. Sheared 2D coordinates of a collinear triangle can round to a
  * non-zero area, so the hit path checks this explicitly (it runs only for rays
  * that pass the inside test). */
-static RC__NOINLINE int rc__tri_zero_area(const float *a, const float *b, const float *c)
+RC__COLD int rc__tri_zero_area(const float *a, const float *b, const float *c)
 {
     const double e1x = (double)b[0] - a[0], e1y = (double)b[1] - a[1], e1z = (double)b[2] - a[2];
     const double e2x = (double)c[0] - a[0], e2y = (double)c[1] - a[1], e2z = (double)c[2] - a[2];
@@ -121,8 +142,8 @@ static RC__NOINLINE int rc__tri_zero_area(const float *a, const float *b, const 
  * returns 1 with *t (in units of |dir|), the barycentrics *u (weight of b) and
  * *v (weight of c): the point is (1 - u - v) a + u b + v c, as in Embree. The
  * caller compares t with its current nearest. */
-static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, const float *b, const float *c,
-                                    float *t, float *u, float *v)
+static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, const float *b,
+                                              const float *c, float *t, float *u, float *v)
 {
     const int kx = r->kx, ky = r->ky, kz = r->kz;
     const float ox = r->org[kx], oy = r->org[ky], oz = r->org[kz];
@@ -132,9 +153,16 @@ static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, 
     const float Ax = (a[kx] - ox) - sx * az, Ay = (a[ky] - oy) - sy * az;
     const float Bx = (b[kx] - ox) - sx * bz, By = (b[ky] - oy) - sy * bz;
     const float Cx = (c[kx] - ox) - sx * cz, Cy = (c[ky] - oy) - sy * cz;
-    float U = Cx * By - Cy * Bx; /* E(B, C) */
-    float V = Ax * Cy - Ay * Cx; /* E(C, A) */
-    float W = Bx * Ay - By * Ax; /* E(A, B) */
+    /* Each product has a second use (the zero test below), which also keeps
+     * GCC from fusing it into an FMA with the subtraction even where FP
+     * contraction is on: the shared edge must give exactly -E in both
+     * triangles. U is exactly 0 when its two products are equal. */
+    const float CxBy = Cx * By, CyBx = Cy * Bx;
+    const float AxCy = Ax * Cy, AyCx = Ay * Cx;
+    const float BxAy = Bx * Ay, ByAx = By * Ax;
+    float U = CxBy - CyBx; /* E(B, C) */
+    float V = AxCy - AyCx; /* E(C, A) */
+    float W = BxAy - ByAx; /* E(A, B) */
     float det, T, tt;
     /* Rounding is monotonic, so a non-zero float edge function has the sign of
      * the exact one: mixed non-zero signs reject at once. Only then are zeros
@@ -146,7 +174,7 @@ static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, 
         const float hi = U > V ? (U > W ? U : W) : (V > W ? V : W);
         if (lo < 0.0f && hi > 0.0f) return 0;
     }
-    if (U == 0.0f || V == 0.0f || W == 0.0f) {
+    if ((CxBy == CyBx) | (AxCy == AyCx) | (BxAy == ByAx)) {
         rc__tri_edges_double(Ax, Ay, Bx, By, Cx, Cy, &U, &V, &W);
         if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return 0;
     }

@@ -14,10 +14,34 @@ rc_status rc__pose_check(const rc_pose *pose)
     return RC_OK;
 }
 
+static void xform_from(const double p[3], const double q[4], rc__xform *out);
+
 void rc__xform_from_pose(const rc_pose *pose, rc__xform *out)
 {
-    double x = pose->orientation[0], y = pose->orientation[1];
-    double z = pose->orientation[2], w = pose->orientation[3];
+    const double p[3] = {pose->position[0], pose->position[1], pose->position[2]};
+    const double q[4] = {pose->orientation[0], pose->orientation[1], pose->orientation[2], pose->orientation[3]};
+    xform_from(p, q, out);
+}
+
+void rc__xform_from_pose_d(const rc_pose_d *pose, rc__xform *out) { xform_from(pose->position, pose->orientation, out); }
+
+rc_status rc__pose_check_d(const rc_pose_d *pose)
+{
+    const double *q = pose->orientation;
+    int i;
+    for (i = 0; i < 3; ++i)
+        if (!isfinite(pose->position[i])) return RC_ERR_NON_FINITE;
+    for (i = 0; i < 4; ++i)
+        if (!isfinite(q[i])) return RC_ERR_NON_FINITE;
+    if (!(fabs(sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]) - 1.0) <= 1e-3))
+        return RC_ERR_INVALID_ARGUMENT;
+    return RC_OK;
+}
+
+static void xform_from(const double p[3], const double q[4], rc__xform *out)
+{
+    double x = q[0], y = q[1];
+    double z = q[2], w = q[3];
     double n = sqrt(x * x + y * y + z * z + w * w);
     if (n > 0.0) {
         x /= n; y /= n; z /= n; w /= n;
@@ -33,9 +57,9 @@ void rc__xform_from_pose(const rc_pose *pose, rc__xform *out)
     out->r[6] = 2.0 * (x * z - y * w);
     out->r[7] = 2.0 * (y * z + x * w);
     out->r[8] = 1.0 - 2.0 * (x * x + y * y);
-    out->t[0] = pose->position[0];
-    out->t[1] = pose->position[1];
-    out->t[2] = pose->position[2];
+    out->t[0] = p[0];
+    out->t[1] = p[1];
+    out->t[2] = p[2];
 }
 
 void rc__xform_mul(const rc__xform *a, const rc__xform *b, rc__xform *out)

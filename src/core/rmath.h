@@ -24,6 +24,9 @@ typedef struct rc__xformf {
 rc_status rc__pose_check(const rc_pose *pose);
 /* Pose to transform (the quaternion normalised). */
 void rc__xform_from_pose(const rc_pose *pose, rc__xform *out);
+void rc__xform_from_pose_d(const rc_pose_d *pose, rc__xform *out);
+/* rc__pose_check for double poses. */
+rc_status rc__pose_check_d(const rc_pose_d *pose);
 /* out = a * b  (apply b first). out may alias neither. */
 void rc__xform_mul(const rc__xform *a, const rc__xform *b, rc__xform *out);
 void rc__xform_to_float(const rc__xform *x, rc__xformf *out);
