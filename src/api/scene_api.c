@@ -264,11 +264,13 @@ static void instance_set(rc__instance *in, const rc_pose *pose, const float scal
     rc__xform_from_pose(pose, &x);
     for (i = 0; i < 3; ++i) {
         for (j = 0; j < 3; ++j) {
-            in->to_world.r[i * 3 + j] = (float)(x.r[i * 3 + j] * scale[j]);
+            in->to_world.rd[i * 3 + j] = x.r[i * 3 + j] * scale[j];
+            in->to_world.r[i * 3 + j] = (float)in->to_world.rd[i * 3 + j];
             in->normal_to_world[i * 3 + j] = (float)(x.r[i * 3 + j] / scale[j]);
             in->to_local.r[j * 3 + i] = (float)(x.r[i * 3 + j] / scale[j]);
         }
         in->to_world.t[i] = (float)x.t[i];
+        in->to_world.td[i] = x.t[i];
     }
     for (j = 0; j < 3; ++j) {
         double t = 0.0;

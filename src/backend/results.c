@@ -34,12 +34,31 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
     const rc_results *out = job->out;
     const uint32_t attr = job->attributes;
     const rc_sensor *sensor = job->sensor;
-    int valid = found && hit->t >= sensor->range_min && hit->t <= sensor->range_max;
+    float t = found ? hit->t : 0.0f;
+    int valid;
     float range;
 
+    if (found) {
+        /* float64 refinement of the distance along the ray (cheap: once per
+         * hit): removes the float rounding of the traversal's t */
+        double od[3], dd[3], td;
+        int a;
+        for (a = 0; a < 3; ++a) {
+            dd[a] = world->rd[3 * a] * dir_s[0] + world->rd[3 * a + 1] * dir_s[1] + world->rd[3 * a + 2] * dir_s[2];
+            od[a] = world->td[a];
+            if (org_s)
+                od[a] += world->rd[3 * a] * org_s[0] + world->rd[3 * a + 1] * org_s[1] + world->rd[3 * a + 2] * org_s[2];
+        }
+        td = rc__scene_hit_distance_d(job->scene, hit, od, dd);
+        /* keep the traversal's t if the plane distance disagrees by more than
+         * float rounding can explain (a hit through an edge of a needle) */
+        if (fabs(td - t) <= 1e-4 * (fabs(td) + 1e-3)) t = (float)td;
+    }
+    valid = found && t >= sensor->range_min && t <= sensor->range_max;
+
     if (valid)
-        range = hit->t;
-    else if (found && hit->t < sensor->range_min)
+        range = t;
+    else if (found && t < sensor->range_min)
         range = -INFINITY;
     else
         range = INFINITY;

@@ -76,8 +76,14 @@ void rc__xform_mul(const rc__xform *a, const rc__xform *b, rc__xform *out)
 void rc__xform_to_float(const rc__xform *x, rc__xformf *out)
 {
     int i;
-    for (i = 0; i < 9; ++i) out->r[i] = (float)x->r[i];
-    for (i = 0; i < 3; ++i) out->t[i] = (float)x->t[i];
+    for (i = 0; i < 9; ++i) {
+        out->r[i] = (float)x->r[i];
+        out->rd[i] = x->r[i];
+    }
+    for (i = 0; i < 3; ++i) {
+        out->t[i] = (float)x->t[i];
+        out->td[i] = x->t[i];
+    }
 }
 
 rc_pose rc_pose_identity(void)

@@ -13,10 +13,13 @@ typedef struct rc__xform {
     double t[3];
 } rc__xform;
 
-/* Float copy of a transform for the hot loops. */
+/* Float copy of a transform for the hot loops, with the double original kept
+ * for the once-per-hit float64 refinement of the distance. */
 typedef struct rc__xformf {
     float r[9];
     float t[3];
+    double rd[9];
+    double td[3];
 } rc__xformf;
 
 /* Checks a pose: finite, quaternion norm within 1e-3 of 1. Returns RC_OK,

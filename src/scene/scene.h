@@ -70,6 +70,12 @@ int rc__scene_up_to_date(const rc_scene *scene);
  * Returns 1 when hit was updated. */
 int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit);
 
+/* The hit's distance recomputed in double: the ray (org + t dir, scene frame)
+ * against the plane of the hit triangle (through its instance's transform in
+ * double). Returns hit->t where the ray is parallel to the plane. */
+double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const double org[3],
+                                const double dir[3]);
+
 /* Unit geometric normal of a hit, in the scene's frame. */
 void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3]);
 

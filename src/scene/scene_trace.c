@@ -101,3 +101,39 @@ void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3])
         n[2] = (float)(n[2] / len);
     }
 }
+
+double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const double org[3], const double dir[3])
+{
+    const rc__mesh *mesh;
+    const rc__xformf *x = NULL;
+    const uint32_t *tri;
+    double v[3][3], e1[3], e2[3], n[3], dn, w;
+    int i, k;
+    if (hit->inst == RC_INVALID_ID) {
+        mesh = &scene->geoms[hit->geom].mesh;
+    } else {
+        x = &scene->insts[hit->inst].to_world;
+        mesh = &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
+    }
+    tri = mesh->indices + (size_t)3 * hit->prim;
+    for (i = 0; i < 3; ++i) {
+        const float *p = mesh->vertices + (size_t)tri[i] * mesh->stride;
+        if (x) {
+            for (k = 0; k < 3; ++k)
+                v[i][k] = x->rd[3 * k] * p[0] + x->rd[3 * k + 1] * p[1] + x->rd[3 * k + 2] * p[2] + x->td[k];
+        } else {
+            for (k = 0; k < 3; ++k) v[i][k] = p[k];
+        }
+    }
+    for (k = 0; k < 3; ++k) {
+        e1[k] = v[1][k] - v[0][k];
+        e2[k] = v[2][k] - v[0][k];
+    }
+    n[0] = e1[1] * e2[2] - e1[2] * e2[1];
+    n[1] = e1[2] * e2[0] - e1[0] * e2[2];
+    n[2] = e1[0] * e2[1] - e1[1] * e2[0];
+    dn = n[0] * dir[0] + n[1] * dir[1] + n[2] * dir[2];
+    w = n[0] * (v[0][0] - org[0]) + n[1] * (v[0][1] - org[1]) + n[2] * (v[0][2] - org[2]);
+    if (dn == 0.0 || !isfinite(w / dn)) return hit->t;
+    return w / dn;
+}
