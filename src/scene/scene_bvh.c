@@ -21,14 +21,17 @@ static void layout_of(const rc_scene_desc *d, accel_layout *l)
     size_t geoms = d->max_geometries ? d->max_geometries : 1u;
     size_t items = geoms + d->max_instances;
     size_t t = (size_t)d->max_triangles;
-    /* sum over meshes of 2*ceil(T_g/4)-1 is at most 2*ceil(T/4) + G - 2 */
-    l->mesh_nodes = t ? 2u * ((t + RC__BVH_MESH_LEAF_SIZE - 1u) / RC__BVH_MESH_LEAF_SIZE) + geoms : 0u;
+    /* sum over meshes of 2*ceil(T_g/4)-1 is at most 2*ceil(T/4) + G - 2; each
+     * mesh's range is padded to an even start (+1 each) so that, with the
+     * array placed as below, every sibling pair shares one 64-byte line */
+    l->mesh_nodes = t ? 2u * ((t + RC__BVH_MESH_LEAF_SIZE - 1u) / RC__BVH_MESH_LEAF_SIZE) + 2u * geoms : 0u;
     l->top_nodes = 2u * items - 1u;
     l->mesh_refs = t;
     l->top_refs = items;
     l->leaf_tris_offset = align16((l->mesh_nodes + l->top_nodes) * sizeof(rc__bvh_node)) +
                           align16((l->mesh_refs + l->top_refs) * sizeof(uint32_t));
-    l->bytes = l->leaf_tris_offset + align16(l->mesh_refs * 3u * sizeof(uint32_t));
+    /* + 64: room to shift the node array so that nodes[1] is 64-byte aligned */
+    l->bytes = l->leaf_tris_offset + align16(l->mesh_refs * 3u * sizeof(uint32_t)) + 64u;
     l->scratch_items = t > items ? t : items;
     l->scratch_bytes = align16(l->scratch_items * sizeof(rc__aabb)) +
                        rc__bvh_build_scratch_bytes((uint32_t)l->scratch_items);
@@ -142,10 +145,16 @@ rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *us
                  (unsigned long long)rc__arena_largest_free(&ctx->arena));
     item_bounds = (rc__aabb *)(void *)scratch;
     builder_scratch = scratch + align16(l.scratch_items * sizeof(rc__aabb));
-    nodes = (rc__bvh_node *)scene->top_block;
-    leaf_tris = (uint32_t *)(void *)((unsigned char *)scene->top_block + l.leaf_tris_offset);
-    refs = (uint32_t *)(void *)((unsigned char *)scene->top_block +
-                                align16((l.mesh_nodes + l.top_nodes) * sizeof(rc__bvh_node)));
+    {
+        /* Sibling pairs start at odd indices (the builder places the root at
+         * 0 and pairs after it): with nodes[1] on a 64-byte boundary each
+         * pair is one cache line, one miss per traversal step. */
+        unsigned char *base = (unsigned char *)scene->top_block;
+        base += (96u - (uintptr_t)base % 64u) % 64u;
+        nodes = (rc__bvh_node *)(void *)base;
+        leaf_tris = (uint32_t *)(void *)(base + l.leaf_tris_offset);
+        refs = (uint32_t *)(void *)(base + align16((l.mesh_nodes + l.top_nodes) * sizeof(rc__bvh_node)));
+    }
 
     for (g = 0; g < scene->geom_count; ++g) {
         rc__geometry *geo = &scene->geoms[g];
@@ -167,7 +176,7 @@ rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *us
             rc__bvh_refit(&geo->mesh.bvh, item_bounds);
         }
         geo->dirty = 0;
-        node_off += n;
+        node_off += n + (n & 1u); /* the next mesh starts at an even index */
         ref_off += geo->mesh.triangle_count;
     }
 
