@@ -19,6 +19,9 @@ help:
 	@echo "make valgrind   tests under valgrind memcheck (leaks are errors)"
 	@echo "make bench      rangecast bench on the standard workload (1M-triangle sphere)"
 	@echo "make install    install into PREFIX (default /usr/local)"
+	@echo "make cross-aarch64 | cross-armhf | cross-riscv64   cross-build and run the suite under qemu-user"
+	@echo "make test-nothreads   the suite with RANGECAST_WITH_THREADS=OFF"
+	@echo "make static-size      static core library size per target (-Os)"
 
 deps-demo:
 	@sh tools/setup-deps.sh demo
