@@ -160,6 +160,46 @@ static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_off[3])
     return 1;
 }
 
+static int octant_of(const rc__ray *r)
+{
+    return (r->inv_dir[0] < 0.0f) | (r->inv_dir[1] < 0.0f) << 1 | (r->inv_dir[2] < 0.0f) << 2;
+}
+
+/* A tile that straddles an axis plane: one packet per octant present (a ray
+ * alone goes through the single-ray traversal). */
+static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
+                            rc__hit *hits, int *found)
+{
+    uint32_t done = 0, i;
+    while (done != (n >= 32u ? 0xFFFFFFFFu : (1u << n) - 1u)) {
+        rc__ray sub[LANES];
+        rc__hit sub_hits[LANES];
+        int sub_found[LANES];
+        uint32_t idx[LANES], m = 0;
+        int oct = -1;
+        for (i = 0; i < n; ++i) {
+            if ((done >> i) & 1u) continue;
+            if (oct < 0) oct = octant_of(&rays[i]);
+            if (octant_of(&rays[i]) != oct) continue;
+            idx[m] = i;
+            sub[m] = rays[i];
+            sub_hits[m] = hits[i];
+            sub_found[m] = 0;
+            ++m;
+            done |= 1u << i;
+        }
+        if (m == 1) {
+            sub_found[0] = rc__mesh_intersect(mesh, &sub[0], geom, inst, &sub_hits[0]);
+        } else {
+            rc__mesh_intersect_packet(mesh, sub, m, geom, inst, sub_hits, sub_found);
+        }
+        for (i = 0; i < m; ++i) {
+            hits[idx[i]] = sub_hits[i];
+            found[idx[i]] |= sub_found[i];
+        }
+    }
+}
+
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
                                uint32_t inst, rc__hit *hits, int *found)
 {
@@ -175,8 +215,12 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
     float tdummy;
 
     if (n == 0 || mesh->bvh.node_count == 0) return;
-    if (n > LANES || !one_octant(rays, n, L.near_off)) {
+    if (n > LANES) {
         for (i = 0; i < n; ++i) found[i] |= rc__mesh_intersect(mesh, &rays[i], geom, inst, &hits[i]);
+        return;
+    }
+    if (!one_octant(rays, n, L.near_off)) {
+        split_by_octant(mesh, rays, n, geom, inst, hits, found);
         return;
     }
     for (i = 0; i < 3; ++i) L.org[i] = rays[0].org[i];
