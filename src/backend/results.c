@@ -50,9 +50,10 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
                 od[a] += world->rd[3 * a] * org_s[0] + world->rd[3 * a + 1] * org_s[1] + world->rd[3 * a + 2] * org_s[2];
         }
         td = rc__scene_hit_distance_d(job->scene, hit, od, dd);
-        /* keep the traversal's t if the plane distance disagrees by more than
-         * float rounding can explain (a hit through an edge of a needle) */
-        if (fabs(td - t) <= 1e-4 * (fabs(td) + 1e-3)) t = (float)td;
+        /* the plane of the hit triangle in double is the better distance, also
+         * for needles and slivers where the float test's t is coarse; a
+         * non-positive value (origin on the plane) keeps the traversal's t */
+        if (td > 0.0 && td < 3.0e38 && (float)td > 0.0f) t = (float)td;
     }
     valid = found && t >= sensor->range_min && t <= sensor->range_max;
 

@@ -138,6 +138,21 @@ RC__COLD int rc__tri_zero_area(const float *a, const float *b, const float *c)
            e1x * e2y - e1y * e2x == 0.0;
 }
 
+/* Distance along the ray to the plane of (a, b, c) in double (float inputs
+ * are exact there); 0 when it is not positive or not finite. */
+RC__COLD int rc__tri_plane_t_double(const rc__ray *r, const float *a, const float *b, const float *c, float *t)
+{
+    const double e1x = (double)b[0] - a[0], e1y = (double)b[1] - a[1], e1z = (double)b[2] - a[2];
+    const double e2x = (double)c[0] - a[0], e2y = (double)c[1] - a[1], e2z = (double)c[2] - a[2];
+    const double nx = e1y * e2z - e1z * e2y, ny = e1z * e2x - e1x * e2z, nz = e1x * e2y - e1y * e2x;
+    const double w = nx * ((double)a[0] - r->org[0]) + ny * ((double)a[1] - r->org[1]) + nz * ((double)a[2] - r->org[2]);
+    const double dn = nx * r->dir[0] + ny * r->dir[1] + nz * r->dir[2];
+    const double td = w / dn;
+    if (!(td > 0.0) || !(td < 3.0e38)) return 0;
+    *t = (float)td;
+    return *t > 0.0f;
+}
+
 /* Watertight test of triangle (a, b, c), either winding. On a hit with t > 0
  * returns 1 with *t (in units of |dir|), the barycentrics *u (weight of b) and
  * *v (weight of c): the point is (1 - u - v) a + u b + v c, as in Embree. The
@@ -183,6 +198,14 @@ static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, 
     T = U * (r->sz * az) + V * (r->sz * bz) + W * (r->sz * cz);
     tt = T / det;
     if (!(tt > 0.0f)) return 0;
+    /* t tiny against the triangle's own extent along the ray: the origin lies
+     * (nearly) in the triangle's plane, where rounding of the sheared
+     * coordinates can fake a small positive t (a sensor on a floor would see
+     * the floor at 1e-6 m). Decide that rare case in double. */
+    if (tt * 1024.0f < (r->sz < 0.0f ? -r->sz : r->sz) * ((az < 0.0f ? -az : az) + (bz < 0.0f ? -bz : bz) +
+                                                           (cz < 0.0f ? -cz : cz))) {
+        if (!rc__tri_plane_t_double(r, a, b, c, &tt)) return 0;
+    }
     if (rc__tri_zero_area(a, b, c)) return 0;
     *t = tt;
     *u = V / det;
