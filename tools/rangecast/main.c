@@ -3,6 +3,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "accuracy.h"
 #include "mesh_load.h"
 #include "range_image.h"
 #include "tool.h"
@@ -20,6 +21,9 @@ static void usage(FILE *f)
         "  simulate   simulate a sensor at poses in a mesh map; write a point cloud (and a range image)\n"
         "  bench      scans per second and range accuracy on a map; prints one JSON line\n"
         "  info       a map's size and bounds, and per backend its arena bytes and build time\n"
+        "  accuracy   every ray against the float64 reference tracer: disagreements, range errors by incidence\n"
+        "  stability  the stability cases (grazing, degenerate, far origin ...) per backend against the reference\n"
+        "  lod        levels of detail of a map (meshoptimizer): speed, bytes, error; writes the coarsest within tolerance\n"
         "  gen        write the benchmark workload (UV sphere, random poses) or the demo map to files\n"
         "  help       this text ('rangecast COMMAND --help' for a command's options)\n"
         "\n"
@@ -41,7 +45,10 @@ int main(int argc, char **argv)
                     {"bench", rcp_cmd_bench},
                     {"demo", rcp_cmd_demo},
                     {"info", rcp_cmd_info},
-                    {"gen", rcp_cmd_gen}};
+                    {"gen", rcp_cmd_gen},
+                    {"accuracy", rcp_cmd_accuracy},
+                    {"stability", rcp_cmd_stability},
+                    {"lod", rcp_cmd_lod}};
     size_t k;
     if (argc < 2) {
         usage(stderr);
