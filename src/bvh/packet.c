@@ -14,10 +14,10 @@
 
 #include <float.h>
 
-#if defined(__SSE2__)
+#if defined(__SSE2__) && !defined(RC__PACKET_FORCE_SCALAR)
 #include <emmintrin.h>
 #define RC__PACKET_SSE2 1
-#elif defined(__ARM_NEON)
+#elif defined(__ARM_NEON) && !defined(RC__PACKET_FORCE_SCALAR)
 #include <arm_neon.h>
 #define RC__PACKET_NEON 1
 #endif
