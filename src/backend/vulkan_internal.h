@@ -1,0 +1,239 @@
+/* The Vulkan compute backend's internal view, shared by src/backend/vulkan*.c.
+ *
+ * Objects and where they live:
+ *   rc__vk_state   one per context, in the context's arena (context_bytes);
+ *                  the instance, device, queue, pipelines, the per-sensor
+ *                  table cache and the per-call buffers (poses, results);
+ *   rc__vk_scene   one per committed scene, in the arena (scene_commit_bytes);
+ *                  the scene's packed arrays in device buffers;
+ *   everything Vulkan allocates (host memory through our allocation
+ *   callbacks, device memory through vkAllocateMemory) is outside the arena
+ *   and reported in rc_memory_stats (backend_bytes, device_bytes).
+ */
+#ifndef RC_BACKEND_VULKAN_INTERNAL_H
+#define RC_BACKEND_VULKAN_INTERNAL_H
+
+#include "backend/backend.h"
+#include "backend/vulkan_layout.h"
+
+#include <vulkan/vulkan.h>
+
+#define RC__VK_PIPELINES 16u     /* cached (attribute mask, model) pipelines */
+#define RC__VK_SENSOR_SLOTS 8u   /* cached sensor ray tables */
+#define RC__VK_SLOTS 2u          /* result buffers in flight (double buffering) */
+
+/* A buffer with its own memory; map != NULL when host-visible (kept mapped). */
+typedef struct rc__vk_buffer {
+    VkBuffer buf;
+    VkDeviceMemory mem;
+    VkDeviceSize size;       /* bytes usable */
+    VkDeviceSize alloc_size; /* bytes of the allocation (counted in device_bytes) */
+    void *map;
+    uint32_t coherent;
+    uint32_t kind;           /* RC__VK_MEM_* */
+} rc__vk_buffer;
+
+/* Memory kinds of rc__vk_buffer_create. */
+#define RC__VK_MEM_DEVICE 0u   /* read by kernels; host-visible only on UMA devices */
+#define RC__VK_MEM_UPLOAD 1u   /* written by the host, read by kernels (and staging) */
+#define RC__VK_MEM_READBACK 2u /* written by kernels, read by the host (cached if possible) */
+
+/* Where each array of a packed scene starts and how many elements it has. */
+typedef struct rc__vk_pack_info {
+    uint64_t nodes, refs, tris, verts, geoms, insts; /* element counts */
+    uint32_t geom_count;   /* the scene's own geometries (top items below it) */
+    uint32_t top_node;     /* first node of the top level */
+    uint32_t top_ref;      /* first ref of the top level */
+    uint32_t flags;        /* 1: one mesh and no instances (no top level needed) */
+} rc__vk_pack_info;
+
+/* A destination for one packed array: up to 4 chunks of 2^shift elements. */
+typedef struct rc__vk_span {
+    unsigned char *chunk[RC__VK_MAX_CHUNKS];
+    uint32_t shift;
+    uint32_t elem_size;
+} rc__vk_span;
+
+typedef struct rc__vk_pack_dst {
+    rc__vk_span nodes, refs, tris, verts, geoms, insts;
+} rc__vk_pack_dst;
+
+typedef struct rc__vk_scene {
+    rc__vk_buffer nodes[RC__VK_MAX_CHUNKS], tris[RC__VK_MAX_CHUNKS], verts[RC__VK_MAX_CHUNKS];
+    rc__vk_buffer refs, geoms, insts;
+    uint32_t node_chunks, tri_chunks, vert_chunks;
+    uint32_t chunked;          /* some array spans several bindings: the 4-binding kernel */
+    uint32_t pack_serial;      /* tags used while another scene instancing this one packs */
+    uint32_t pack_first_geom;
+    uint32_t fill_serial;
+    rc__vk_pack_info info;
+} rc__vk_scene;
+
+typedef struct rc__vk_pipeline {
+    VkPipeline pipe;
+    uint32_t attributes;
+    uint32_t model;
+    uint32_t chunked;        /* the 4-binding kernel */
+    uint32_t reserved0;
+    uint64_t last_use;
+} rc__vk_pipeline;
+
+typedef struct rc__vk_sensor_slot {
+    const rc_sensor *sensor; /* identity is checked by content hash too */
+    uint64_t hash;
+    uint64_t last_use;
+    uint32_t model;          /* RC__VK_MODEL_* */
+    uint32_t rays;
+    rc__vk_buffer table;
+} rc__vk_sensor_slot;
+
+typedef struct rc__vk_state {
+    rc_context *ctx;
+    VkAllocationCallbacks alloc;
+    uint64_t host_bytes;     /* bytes the driver holds through our callbacks */
+    uint64_t device_bytes;   /* bytes of VkDeviceMemory we hold, all kinds */
+    uint64_t heap_bytes;     /* of which in RC__VK_MEM_DEVICE memory */
+
+    VkInstance instance;
+    VkPhysicalDevice phys;
+    VkDevice device;
+    VkQueue queue;
+    uint32_t queue_family;
+    uint32_t lost;           /* VK_ERROR_DEVICE_LOST seen: only destroy works */
+    VkPhysicalDeviceProperties props;
+    VkPhysicalDeviceMemoryProperties mem_props;
+    uint64_t max_alloc;      /* maxMemoryAllocationSize */
+    uint64_t max_binding;    /* maxStorageBufferRange (or the test override) */
+    uint64_t heap_size;      /* size of the heap device buffers come from */
+    uint32_t subgroup_size;
+    uint32_t fp64;           /* shaderFloat64 enabled: the RC_FP64 1 kernel */
+    uint32_t chunks;         /* most bindings per large array: 1 or 4 */
+    uint32_t node_shift, tri_shift, vert_shift;
+    uint32_t wg_size;        /* workgroup size */
+    uint32_t device_mappable;/* device memory is host-visible: no staging copies */
+    uint64_t slot_bytes;     /* most bytes of results one dispatch writes */
+
+    VkCommandPool cmd_pool;
+    VkCommandBuffer cmd[RC__VK_SLOTS];
+    VkFence fence[RC__VK_SLOTS];
+    uint32_t inflight[RC__VK_SLOTS];
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout pipe_layout;
+    VkDescriptorPool desc_pool;
+    VkShaderModule module[2];/* the 1-binding kernel; the 4-binding one (when chunks == 4) */
+    VkPipelineCache cache;
+    rc__vk_pipeline pipes[RC__VK_PIPELINES];
+    rc__vk_sensor_slot sensors[RC__VK_SENSOR_SLOTS];
+    rc__vk_buffer xforms;
+    rc__vk_buffer out[RC__VK_SLOTS];
+    uint64_t clock;          /* use counter for the caches */
+    uint32_t serial;         /* pack serial */
+    uint32_t reserved0;
+    char device_name[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
+} rc__vk_state;
+
+/* Allocation callbacks of objects below the device: NULL, so the driver uses
+ * the device's (ours, counting). Passing ours per object as well tripped
+ * lavapipe 22.3, which frees some per-object memory with the device allocator. */
+#define RC__VK_OBJ_ALLOC NULL
+
+static inline rc__vk_state *rc__vk(const rc_context *ctx) { return (rc__vk_state *)ctx->backend_data; }
+
+/* vulkan_device.c --------------------------------------------------------- */
+
+/* "VK_ERROR_DEVICE_LOST" etc. Never NULL. */
+const char *rc__vk_result_name(VkResult r);
+/* Turns a failed VkResult into a status with a message naming the call and
+ * the result; VK_ERROR_DEVICE_LOST marks the state lost. */
+rc_status rc__vk_fail(rc__vk_state *st, VkResult r, const char *what);
+#define RC__VK_TRY(st, call, what)                           \
+    do {                                                     \
+        VkResult rc__vk_r_ = (call);                         \
+        if (rc__vk_r_ != VK_SUCCESS) return rc__vk_fail((st), rc__vk_r_, (what)); \
+    } while (0)
+
+/* 1 when a Vulkan 1.1 loader is present. */
+int rc__vk_loader_ok(void);
+/* Instance, device choice (RANGECAST_VULKAN_DEVICE), queue, limits, memory types. */
+rc_status rc__vk_device_create(rc__vk_state *st);
+void rc__vk_device_destroy(rc__vk_state *st);
+
+/* Creates a buffer of size bytes (storage + transfer usage) in memory of the
+ * given kind (RC__VK_MEM_*); host-visible memory is mapped.
+ * RC_ERR_OUT_OF_MEMORY, with `what` in the message, when it cannot fit. */
+rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kind, const char *what,
+                               rc__vk_buffer *out);
+void rc__vk_buffer_destroy(rc__vk_state *st, rc__vk_buffer *b);
+/* Makes host writes visible / device writes visible to the host (non-coherent memory). */
+rc_status rc__vk_buffer_flush(rc__vk_state *st, const rc__vk_buffer *b);
+rc_status rc__vk_buffer_invalidate(rc__vk_state *st, const rc__vk_buffer *b);
+/* Records, submits and waits for copies src -> dst (regions). */
+rc_status rc__vk_copy(rc__vk_state *st, const rc__vk_buffer *src, const rc__vk_buffer *dst, VkDeviceSize src_off,
+                      VkDeviceSize size);
+/* Command slots (command buffer + fence): wait for one (no-op when idle),
+ * begin recording into it (waits first), submit it. */
+rc_status rc__vk_wait(rc__vk_state *st, uint32_t slot);
+rc_status rc__vk_begin(rc__vk_state *st, uint32_t slot);
+rc_status rc__vk_submit(rc__vk_state *st, uint32_t slot);
+/* A global memory barrier (skipped on CPU devices, see vulkan_device.c). */
+void rc__vk_barrier(rc__vk_state *st, VkCommandBuffer cb, VkPipelineStageFlags src_stage, VkAccessFlags src,
+                    VkPipelineStageFlags dst_stage, VkAccessFlags dst);
+
+/* vulkan_shaders.c -------------------------------------------------------- */
+
+/* SPIR-V of raycast.comp for the variant, and of layout_check.comp. */
+const uint32_t *rc__vk_raycast_spirv(int fp64, uint32_t chunks, size_t *bytes);
+const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
+
+/* vulkan_pack.c ----------------------------------------------------------- */
+
+/* Counts the packed arrays of a scene whose BVH is built; tags the instance
+ * sources' rc__vk_scene with serial. */
+void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info);
+/* Writes them (after rc__vk_pack_count with the same serial). */
+void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
+
+/* Host copy of packed arrays (linear, one chunk each). */
+typedef struct rc__vk_packed {
+    rc__vk_pack_info info;
+    const rc__bvh_node *nodes;
+    const uint32_t *refs;
+    const uint32_t *tris;
+    const float *verts;
+    const rc__vk_geom *geoms;
+    const rc__vk_inst *insts;
+} rc__vk_packed;
+
+/* The C traversal of the packed arrays, with the CPU's own inner tests: must
+ * find exactly what rc__scene_intersect finds (the test proves the packing). */
+int rc__vk_packed_intersect(const rc__vk_packed *p, const rc__ray *ray, rc__hit *hit);
+
+/* vulkan_scene.c ---------------------------------------------------------- */
+
+rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user);
+void rc__vk_scene_release(rc_scene *scene);
+size_t rc__vk_scene_commit_bytes(const rc_scene_desc *desc);
+
+/* vulkan_sensor.c --------------------------------------------------------- */
+
+/* The sensor's ray table on the device (uploaded on first use, cached). */
+rc_status rc__vk_sensor_table(rc__vk_state *st, const rc_sensor *sensor, rc__vk_sensor_slot **out);
+void rc__vk_sensor_cache_clear(rc__vk_state *st);
+
+/* vulkan_sim.c ------------------------------------------------------------- */
+
+rc_status rc__vk_pipelines_create(rc__vk_state *st);
+void rc__vk_pipelines_destroy(rc__vk_state *st);
+rc_status rc__vk_simulate(rc_context *ctx, const rc__sim_job *job);
+
+/* vulkan.c (tests) ---------------------------------------------------------- */
+
+/* Runs layout_check.comp on known values: RC_OK when GLSL reads every member
+ * where C wrote it, else RC_ERR_BACKEND naming the first mismatch. */
+rc_status rc__vk_layout_check(rc_context *ctx);
+/* Test hook: behave as if the device had been lost. */
+void rc__vk_debug_mark_lost(rc_context *ctx);
+/* Test hook: the device name and whether the float64 kernel runs. */
+const char *rc__vk_device_name(const rc_context *ctx, int *fp64, uint32_t *chunks);
+
+#endif

@@ -1,0 +1,289 @@
+/* Packing a committed scene into the flat arrays the kernels read (layout in
+ * kernels/layout.glsl), and a C traversal of those arrays.
+ *
+ * The arrays are the canonical BVH, concatenated: every mesh's nodes and refs
+ * as rc__bvh_build made them (child and leaf indices stay relative to the
+ * mesh: the kernel adds node_base/ref_base), then the scene's top level. The
+ * meshes are the scene's own geometries, then the geometries of every scene
+ * its instances use, each such source once. Triangles are rewritten with
+ * global vertex indices and vertices repacked to 3 floats whatever the input
+ * stride; triangles are stored in leaf order (slot j of a mesh's refs holds
+ * the vertex indices of triangle refs[j], so a leaf is one contiguous read and
+ * the ref is read only for a hit's id), zero-area ones (rc__tri_zero_area) as
+ * (a, a, a) so the kernel needs no double test for them. One builder, two traversals (this one and raycast.comp) of the same
+ * arrays; the C one uses the CPU backend's own inner tests, so comparing it
+ * with rc__scene_intersect checks the packing alone. */
+#include "backend/vulkan_internal.h"
+
+#include "bvh/intersect.h"
+
+#include <string.h>
+
+static void span_write(const rc__vk_span *s, uint64_t first, const void *src, uint64_t count)
+{
+    const unsigned char *p = (const unsigned char *)src;
+    const uint64_t per = (uint64_t)1 << s->shift;
+    while (count) {
+        const uint64_t c = first >> s->shift, off = first & (per - 1u);
+        const uint64_t room = per - off, n = count < room ? count : room;
+        memcpy(s->chunk[c] + off * s->elem_size, p, (size_t)(n * s->elem_size));
+        p += n * s->elem_size;
+        first += n;
+        count -= n;
+    }
+}
+
+static rc__vk_scene *vk_scene_of(const rc_scene *scene) { return (rc__vk_scene *)scene->backend_scene; }
+
+/* Every BVH starts at an odd node index, as in the scene's own block: its
+ * sibling pairs (at odd indices within it) then fill whole 64-byte lines. */
+static uint64_t pair_aligned(uint64_t node) { return node | 1u; }
+
+static void count_mesh(const rc__mesh *m, rc__vk_pack_info *info)
+{
+    info->nodes = pair_aligned(info->nodes) + m->bvh.node_count;
+    info->refs += m->bvh.item_count;
+    info->tris += m->triangle_count;
+    info->verts += m->vertex_count;
+    info->geoms += 1u;
+}
+
+void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
+{
+    uint32_t g, i;
+    memset(info, 0, sizeof *info);
+    for (g = 0; g < scene->geom_count; ++g) count_mesh(&scene->geoms[g].mesh, info);
+    for (i = 0; i < scene->inst_count; ++i) {
+        const rc_scene *src = scene->insts[i].source;
+        rc__vk_scene *sv = vk_scene_of(src);
+        if (sv->pack_serial == serial) continue;
+        sv->pack_serial = serial;
+        sv->pack_first_geom = (uint32_t)info->geoms;
+        for (g = 0; g < src->geom_count; ++g) count_mesh(&src->geoms[g].mesh, info);
+    }
+    info->insts = scene->inst_count;
+    info->geom_count = scene->geom_count;
+    info->top_node = (uint32_t)pair_aligned(info->nodes);
+    info->top_ref = (uint32_t)info->refs;
+    info->nodes = info->top_node;
+    info->nodes += scene->top.node_count;
+    info->refs += scene->top.item_count;
+    info->flags = (scene->geom_count == 1 && scene->inst_count == 0) ? 1u : 0u;
+}
+
+typedef struct pack_cursor {
+    uint64_t node, ref, tri, vert, geom;
+} pack_cursor;
+
+#define PACK_BATCH 512u
+
+static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst *dst, pack_cursor *c)
+{
+    rc__vk_geom entry;
+    uint32_t batch[3u * PACK_BATCH];
+    float vbatch[3u * PACK_BATCH];
+    uint32_t i, k, n;
+    if (c->node != pair_aligned(c->node)) { /* the padding node: never read */
+        static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
+        span_write(&dst->nodes, c->node, &pad, 1);
+        c->node = pair_aligned(c->node);
+    }
+    entry.node_base = (uint32_t)c->node;
+    entry.ref_base = (uint32_t)c->ref;
+    entry.tri_base = (uint32_t)c->tri;
+    entry.geom_id = geom_id;
+    span_write(&dst->geoms, c->geom, &entry, 1);
+    span_write(&dst->nodes, c->node, m->bvh.nodes, m->bvh.node_count);
+    span_write(&dst->refs, c->ref, m->bvh.refs, m->bvh.item_count);
+    for (i = 0; i < m->triangle_count; i += n) {
+        n = m->triangle_count - i < PACK_BATCH ? m->triangle_count - i : PACK_BATCH;
+        for (k = 0; k < n; ++k) {
+            /* leaf order: slot i + k holds the triangle refs[i + k] names */
+            const uint32_t *t = m->indices + (size_t)3u * m->bvh.refs[i + k];
+            /* rc__tri_zero_area, decided once here in double: such a triangle
+             * is written (a, a, a), which every test rejects (det == 0) */
+            const int flat = rc__tri_zero_area(m->vertices + (size_t)t[0] * m->stride,
+                                               m->vertices + (size_t)t[1] * m->stride,
+                                               m->vertices + (size_t)t[2] * m->stride);
+            batch[3u * k] = t[0] + (uint32_t)c->vert;
+            batch[3u * k + 1u] = (flat ? t[0] : t[1]) + (uint32_t)c->vert;
+            batch[3u * k + 2u] = (flat ? t[0] : t[2]) + (uint32_t)c->vert;
+        }
+        span_write(&dst->tris, c->tri + i, batch, n);
+    }
+    for (i = 0; i < m->vertex_count; i += n) {
+        n = m->vertex_count - i < PACK_BATCH ? m->vertex_count - i : PACK_BATCH;
+        for (k = 0; k < n; ++k) memcpy(vbatch + 3u * k, m->vertices + (size_t)(i + k) * m->stride, 3 * sizeof(float));
+        span_write(&dst->verts, c->vert + i, vbatch, n);
+    }
+    c->node += m->bvh.node_count;
+    c->ref += m->bvh.item_count;
+    c->tri += m->triangle_count;
+    c->vert += m->vertex_count;
+    c->geom += 1u;
+}
+
+void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst)
+{
+    pack_cursor c;
+    uint32_t g, i;
+    memset(&c, 0, sizeof c);
+    for (g = 0; g < scene->geom_count; ++g) fill_mesh(&scene->geoms[g].mesh, g, dst, &c);
+    for (i = 0; i < scene->inst_count; ++i) {
+        const rc__instance *in = &scene->insts[i];
+        rc__vk_scene *sv = vk_scene_of(in->source);
+        rc__vk_inst entry;
+        int r;
+        if (sv->fill_serial != serial) { /* first use of this source: its meshes go here */
+            sv->fill_serial = serial;
+            for (g = 0; g < in->source->geom_count; ++g) fill_mesh(&in->source->geoms[g].mesh, g, dst, &c);
+        }
+        memset(&entry, 0, sizeof entry);
+        for (r = 0; r < 3; ++r) {
+            entry.to_local[4 * r + 0] = in->to_local.r[3 * r + 0];
+            entry.to_local[4 * r + 1] = in->to_local.r[3 * r + 1];
+            entry.to_local[4 * r + 2] = in->to_local.r[3 * r + 2];
+            entry.to_local[4 * r + 3] = in->to_local.t[r];
+            entry.n2w[4 * r + 0] = in->normal_to_world[3 * r + 0];
+            entry.n2w[4 * r + 1] = in->normal_to_world[3 * r + 1];
+            entry.n2w[4 * r + 2] = in->normal_to_world[3 * r + 2];
+        }
+        {
+            double d[12];
+            memcpy(d, in->to_world.rd, 9 * sizeof(double));
+            memcpy(d + 9, in->to_world.td, 3 * sizeof(double));
+            memcpy(entry.to_world_d, d, sizeof entry.to_world_d);
+        }
+        entry.first_geom = sv->pack_first_geom;
+        entry.geom_count = in->source->geom_count;
+        span_write(&dst->insts, i, &entry, 1);
+    }
+    if (c.node < info->top_node) {
+        static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
+        span_write(&dst->nodes, c.node, &pad, 1);
+    }
+    span_write(&dst->nodes, info->top_node, scene->top.nodes, scene->top.node_count);
+    span_write(&dst->refs, info->top_ref, scene->top.refs, scene->top.item_count);
+}
+
+/* ---- the C traversal of the packed arrays -------------------------------------- */
+
+typedef struct packed_entry {
+    uint32_t node;
+    float tnear;
+} packed_entry;
+
+static int packed_mesh(const rc__vk_packed *p, uint32_t gi, uint32_t geom_id, uint32_t inst, const rc__ray *ray,
+                       rc__hit *hit)
+{
+    const rc__vk_geom g = p->geoms[gi];
+    const rc__bvh_node *nodes = p->nodes + g.node_base;
+    rc__slab_ray s;
+    packed_entry stack[RC__BVH_MAX_DEPTH];
+    uint32_t sp = 0, ni = 0;
+    float tn;
+    int found = 0;
+    rc__slab_ray_init(&s, ray);
+    if (!rc__node_hit(&nodes[0], &s, hit->t, &tn)) return 0;
+    for (;;) {
+        const rc__bvh_node *n = &nodes[ni];
+        if (n->count == 0) {
+            const uint32_t c = n->index;
+            float t0, t1;
+            const int h0 = rc__node_hit(&nodes[c], &s, hit->t, &t0);
+            const int h1 = rc__node_hit(&nodes[c + 1], &s, hit->t, &t1);
+            if (h0 && h1) {
+                ni = t1 < t0 ? c + 1 : c;
+                if (sp < RC__BVH_MAX_DEPTH) {
+                    stack[sp].node = t1 < t0 ? c : c + 1;
+                    stack[sp].tnear = t1 < t0 ? t0 : t1;
+                    ++sp;
+                }
+                continue;
+            }
+            if (h0 || h1) {
+                ni = h0 ? c : c + 1;
+                continue;
+            }
+        } else {
+            uint32_t j;
+            for (j = n->index; j < n->index + n->count; ++j) {
+                const uint32_t prim = p->refs[g.ref_base + j];
+                const uint32_t *tri = p->tris + (size_t)3u * (g.tri_base + j);
+                float t, u, v;
+                if (!rc__tri_intersect(ray, p->verts + (size_t)3u * tri[0], p->verts + (size_t)3u * tri[1],
+                                       p->verts + (size_t)3u * tri[2], &t, &u, &v))
+                    continue;
+                if (t > hit->t) continue;
+                if (t == hit->t && !rc__hit_key_less(inst, geom_id, prim, hit)) continue;
+                hit->t = t;
+                hit->u = u;
+                hit->v = v;
+                hit->prim = prim;
+                hit->geom = geom_id;
+                hit->inst = inst;
+                found = 1;
+            }
+        }
+        for (;;) {
+            if (sp == 0) return found;
+            --sp;
+            if (stack[sp].tnear <= hit->t) {
+                ni = stack[sp].node;
+                break;
+            }
+        }
+    }
+}
+
+int rc__vk_packed_intersect(const rc__vk_packed *p, const rc__ray *ray, rc__hit *hit)
+{
+    uint32_t stack[RC__BVH_MAX_DEPTH + 1];
+    uint32_t sp = 0, ni = 0;
+    int found = 0;
+    rc__slab_ray s;
+    if (p->info.flags & 1u) return packed_mesh(p, 0, 0, RC_INVALID_ID, ray, hit);
+    rc__slab_ray_init(&s, ray);
+    for (;;) {
+        const rc__bvh_node *n = &p->nodes[p->info.top_node + ni];
+        float tn;
+        if (rc__node_hit(n, &s, hit->t, &tn)) {
+            if (n->count == 0) {
+                if (sp <= RC__BVH_MAX_DEPTH) stack[sp++] = n->index + 1;
+                ni = n->index;
+                continue;
+            } else {
+                uint32_t k;
+                for (k = 0; k < n->count; ++k) {
+                    const uint32_t item = p->refs[p->info.top_ref + n->index + k];
+                    if (item < p->info.geom_count) {
+                        found |= packed_mesh(p, item, item, RC_INVALID_ID, ray, hit);
+                    } else {
+                        const uint32_t inst = item - p->info.geom_count;
+                        const rc__vk_inst *in = &p->insts[inst];
+                        float r[9], o[3], d[3];
+                        rc__ray local;
+                        uint32_t g;
+                        int a;
+                        for (a = 0; a < 3; ++a) {
+                            r[3 * a] = in->to_local[4 * a];
+                            r[3 * a + 1] = in->to_local[4 * a + 1];
+                            r[3 * a + 2] = in->to_local[4 * a + 2];
+                        }
+                        rc__rot_apply_f(r, ray->org, o);
+                        o[0] += in->to_local[3];
+                        o[1] += in->to_local[7];
+                        o[2] += in->to_local[11];
+                        rc__rot_apply_f(r, ray->dir, d);
+                        rc__ray_prepare(&local, o, d);
+                        for (g = 0; g < in->geom_count; ++g)
+                            found |= packed_mesh(p, in->first_geom + g, g, inst, &local, hit);
+                    }
+                }
+            }
+        }
+        if (sp == 0) break;
+        ni = stack[--sp];
+    }
+    return found;
+}

@@ -1,0 +1,200 @@
+/* Scene commit for the Vulkan backend: build the canonical two-level BVH in
+ * the arena (exactly as the BVH backend does), then pack it with the meshes
+ * into device buffers (vulkan_pack.c).
+ *
+ * Large arrays (nodes, triangles, vertices) are split into up to 4 buffers of
+ * at most maxStorageBufferRange bytes, one binding each, when the device has
+ * the bindings for it (st->chunks); refs, geometries and instances have one
+ * binding. Only a scene that needs the split runs the 4-binding kernel (each
+ * load picks its binding: a cost on masked-execution devices like lavapipe). A scene that needs more fails with RC_ERR_OUT_OF_MEMORY naming the
+ * array and the limit; so does one that does not fit the device heap, which is
+ * checked before allocating so it never reaches the driver's limits.
+ * Arena use: the rc__vk_scene record plus the BVH (rc__scene_bvh_commit_bytes). */
+#include "backend/vulkan_internal.h"
+
+#include <string.h>
+
+size_t rc__vk_scene_commit_bytes(const rc_scene_desc *desc)
+{
+    return rc__scene_bvh_commit_bytes(desc) + rc__arena_cost(sizeof(rc__vk_scene));
+}
+
+static void release_buffers(rc__vk_state *st, rc__vk_scene *sv)
+{
+    uint32_t c;
+    for (c = 0; c < RC__VK_MAX_CHUNKS; ++c) {
+        rc__vk_buffer_destroy(st, &sv->nodes[c]);
+        rc__vk_buffer_destroy(st, &sv->tris[c]);
+        rc__vk_buffer_destroy(st, &sv->verts[c]);
+    }
+    rc__vk_buffer_destroy(st, &sv->refs);
+    rc__vk_buffer_destroy(st, &sv->geoms);
+    rc__vk_buffer_destroy(st, &sv->insts);
+    sv->node_chunks = sv->tri_chunks = sv->vert_chunks = sv->chunked = 0;
+    memset(&sv->info, 0, sizeof sv->info);
+}
+
+void rc__vk_scene_release(rc_scene *scene)
+{
+    rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
+    if (!sv) return;
+    release_buffers(rc__vk(scene->ctx), sv);
+    rc__arena_free(&scene->ctx->arena, sv);
+    scene->backend_scene = NULL;
+}
+
+/* One packed array: its element count, size and where its buffers go. */
+typedef struct array_plan {
+    const char *name;
+    uint64_t count;
+    uint32_t elem_size;
+    uint32_t shift;     /* elements per buffer = 2^shift */
+    uint32_t max_chunks;
+    uint32_t chunks;
+    rc__vk_buffer *bufs;
+    uint64_t staging_off[RC__VK_MAX_CHUNKS];
+} array_plan;
+
+static uint64_t chunk_elems(const array_plan *a, uint32_t c)
+{
+    const uint64_t per = (uint64_t)1 << a->shift, first = (uint64_t)c * per;
+    const uint64_t left = a->count > first ? a->count - first : 0;
+    return left < per ? left : per;
+}
+
+static rc_status plan_array(rc__vk_state *st, array_plan *a)
+{
+    const uint64_t per = (uint64_t)1 << a->shift;
+    const uint64_t limit = per * a->max_chunks;
+    a->chunks = a->count ? (uint32_t)((a->count + per - 1u) / per) : 1u;
+    RC_RETURN_IF(st->ctx, a->count > limit || a->count > 0xFFFFFFFFu, RC_ERR_OUT_OF_MEMORY,
+                 "vulkan: the scene needs %llu %s (%llu bytes); %s holds at most %llu in %u binding%s of "
+                 "maxStorageBufferRange = %llu bytes",
+                 (unsigned long long)a->count, a->name, (unsigned long long)a->count * a->elem_size, st->device_name,
+                 (unsigned long long)(limit < 0xFFFFFFFFu ? limit : 0xFFFFFFFFu), (unsigned)a->max_chunks,
+                 a->max_chunks > 1 ? "s" : "", (unsigned long long)st->max_binding);
+    return RC_OK;
+}
+
+static void span_of(const array_plan *a, const rc__vk_buffer *staging, rc__vk_span *s)
+{
+    uint32_t c;
+    memset(s, 0, sizeof *s);
+    s->shift = a->shift;
+    s->elem_size = a->elem_size;
+    for (c = 0; c < a->chunks; ++c)
+        s->chunk[c] = staging ? (unsigned char *)staging->map + a->staging_off[c] : (unsigned char *)a->bufs[c].map;
+}
+
+rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user)
+{
+    rc_context *ctx = scene->ctx;
+    rc__vk_state *st = rc__vk(ctx);
+    rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
+    rc__vk_pack_info info;
+    rc__vk_pack_dst dst;
+    rc__vk_buffer staging;
+    array_plan arrays[6];
+    uint64_t staging_bytes = 0;
+    uint32_t serial, a, c;
+    rc_status s = RC_OK;
+
+    RC_RETURN_IF(ctx, st->lost, RC_ERR_DEVICE_LOST, "vulkan: the device was lost; destroy the context");
+    if (!sv) {
+        sv = (rc__vk_scene *)rc__arena_calloc(&ctx->arena, sizeof *sv);
+        RC_RETURN_IF(ctx, sv == NULL, RC_ERR_OUT_OF_MEMORY,
+                     "arena has no room for the Vulkan scene record (%llu bytes; largest free block %llu)",
+                     (unsigned long long)rc__arena_cost(sizeof *sv),
+                     (unsigned long long)rc__arena_largest_free(&ctx->arena));
+        scene->backend_scene = sv;
+    }
+    RC_TRY(rc__scene_build_bvh(scene, progress, user));
+    release_buffers(st, sv);
+
+    if (++st->serial == 0) ++st->serial;
+    serial = st->serial;
+    rc__vk_pack_count(scene, serial, &info);
+
+    memset(arrays, 0, sizeof arrays);
+    arrays[0].name = "BVH nodes";
+    arrays[0].count = info.nodes;
+    arrays[0].elem_size = (uint32_t)sizeof(rc__bvh_node);
+    arrays[0].shift = st->node_shift;
+    arrays[0].max_chunks = st->chunks;
+    arrays[0].bufs = sv->nodes;
+    arrays[1].name = "triangles";
+    arrays[1].count = info.tris;
+    arrays[1].elem_size = 12u;
+    arrays[1].shift = st->tri_shift;
+    arrays[1].max_chunks = st->chunks;
+    arrays[1].bufs = sv->tris;
+    arrays[2].name = "vertices";
+    arrays[2].count = info.verts;
+    arrays[2].elem_size = 12u;
+    arrays[2].shift = st->vert_shift;
+    arrays[2].max_chunks = st->chunks;
+    arrays[2].bufs = sv->verts;
+    arrays[3].name = "BVH refs";
+    arrays[3].count = info.refs;
+    arrays[3].elem_size = 4u;
+    arrays[3].bufs = &sv->refs;
+    arrays[4].name = "geometry records";
+    arrays[4].count = info.geoms;
+    arrays[4].elem_size = (uint32_t)sizeof(rc__vk_geom);
+    arrays[4].bufs = &sv->geoms;
+    arrays[5].name = "instance records";
+    arrays[5].count = info.insts;
+    arrays[5].elem_size = (uint32_t)sizeof(rc__vk_inst);
+    arrays[5].bufs = &sv->insts;
+    for (a = 3; a < 6; ++a) { /* one binding each */
+        uint64_t bytes = st->max_binding < st->max_alloc ? st->max_binding : st->max_alloc;
+        uint32_t shift = 0;
+        while (shift < 31u && ((uint64_t)2 << shift) * arrays[a].elem_size <= bytes) ++shift;
+        arrays[a].shift = shift;
+        arrays[a].max_chunks = 1;
+    }
+    for (a = 0; a < 6; ++a) RC_TRY(plan_array(st, &arrays[a]));
+
+    /* Device buffers (every array gets at least one, so each binding is valid). */
+    for (a = 0; a < 6 && s == RC_OK; ++a)
+        for (c = 0; c < arrays[a].chunks && s == RC_OK; ++c) {
+            const uint64_t bytes = chunk_elems(&arrays[a], c) * arrays[a].elem_size;
+            arrays[a].staging_off[c] = staging_bytes;
+            staging_bytes += (bytes + 15u) & ~(uint64_t)15u;
+            s = rc__vk_buffer_create(st, bytes, RC__VK_MEM_DEVICE, arrays[a].name, &arrays[a].bufs[c]);
+        }
+    sv->node_chunks = arrays[0].chunks;
+    sv->tri_chunks = arrays[1].chunks;
+    sv->vert_chunks = arrays[2].chunks;
+    sv->chunked = sv->node_chunks > 1 || sv->tri_chunks > 1 || sv->vert_chunks > 1;
+    if (s != RC_OK) goto fail;
+
+    memset(&staging, 0, sizeof staging);
+    if (!st->device_mappable) {
+        s = rc__vk_buffer_create(st, staging_bytes, RC__VK_MEM_UPLOAD, "upload staging", &staging);
+        if (s != RC_OK) goto fail;
+    }
+    span_of(&arrays[0], st->device_mappable ? NULL : &staging, &dst.nodes);
+    span_of(&arrays[1], st->device_mappable ? NULL : &staging, &dst.tris);
+    span_of(&arrays[2], st->device_mappable ? NULL : &staging, &dst.verts);
+    span_of(&arrays[3], st->device_mappable ? NULL : &staging, &dst.refs);
+    span_of(&arrays[4], st->device_mappable ? NULL : &staging, &dst.geoms);
+    span_of(&arrays[5], st->device_mappable ? NULL : &staging, &dst.insts);
+    rc__vk_pack_fill(scene, serial, &info, &dst);
+
+    for (a = 0; a < 6 && s == RC_OK; ++a)
+        for (c = 0; c < arrays[a].chunks && s == RC_OK; ++c) {
+            const uint64_t bytes = chunk_elems(&arrays[a], c) * arrays[a].elem_size;
+            if (st->device_mappable)
+                s = rc__vk_buffer_flush(st, &arrays[a].bufs[c]);
+            else if (bytes)
+                s = rc__vk_copy(st, &staging, &arrays[a].bufs[c], arrays[a].staging_off[c], bytes);
+        }
+    rc__vk_buffer_destroy(st, &staging);
+    if (s != RC_OK) goto fail;
+    sv->info = info;
+    return RC_OK;
+fail:
+    release_buffers(st, sv);
+    return s;
+}
