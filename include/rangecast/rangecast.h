@@ -175,6 +175,12 @@ typedef struct rc_context_desc {
     size_t memory_size;
     rc_log_fn log;          /* optional */
     void *log_user;
+    /* RC_BACKEND_VULKAN: which device. NULL or "" = the first discrete or
+     * integrated GPU, else any device (lavapipe); a decimal number picks by
+     * index as enumerated; anything else is a case-insensitive substring of
+     * the device name. No match: RC_ERR_UNSUPPORTED. Read during create only.
+     * (The environment variable RANGECAST_VULKAN_DEVICE is used when NULL.) */
+    const char *device;
     uint32_t reserved[8];   /* must be 0 */
 } rc_context_desc;
 

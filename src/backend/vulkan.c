@@ -11,7 +11,7 @@
  *
  * Device: the first discrete GPU, else integrated, else any (Mesa's lavapipe
  * CPU device); RANGECAST_VULKAN_DEVICE picks one by index or name substring
- * (an rc_context_desc field should replace it). AUTO never picks Vulkan.
+ * (rc_context_desc.device overrides it). AUTO never picks Vulkan.
  *
  * Memory: the arena holds only rc__vk_state (context_bytes) and one
  * rc__vk_scene per committed scene next to its BVH (scene_commit_bytes);
@@ -60,13 +60,14 @@ static rc_status vk_init(rc_context *ctx, const rc_context_desc *desc)
 {
     rc__vk_state *st;
     rc_status s;
-    (void)desc;
     st = (rc__vk_state *)rc__arena_calloc(&ctx->arena, sizeof *st);
     RC_RETURN_IF(ctx, st == NULL, RC_ERR_OUT_OF_MEMORY, "arena has no room for the Vulkan backend state (%llu bytes)",
                  (unsigned long long)rc__arena_cost(sizeof *st));
     st->ctx = ctx;
+    st->want_device = desc->device;
     ctx->backend_data = st;
     s = rc__vk_device_create(st);
+    st->want_device = NULL; /* the caller's string is not kept */
     if (s == RC_OK) s = rc__vk_pipelines_create(st);
     if (s != RC_OK) {
         teardown(st);

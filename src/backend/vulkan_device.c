@@ -220,7 +220,7 @@ static rc_status pick_device(rc__vk_state *st)
     VkPhysicalDeviceProperties props[RC__VK_MAX_DEVICES];
     uint32_t n = RC__VK_MAX_DEVICES, i, family = 0;
     int best = -1;
-    const char *want = getenv("RANGECAST_VULKAN_DEVICE");
+    const char *want = st->want_device ? st->want_device : getenv("RANGECAST_VULKAN_DEVICE");
     char names[384];
     size_t used = 0;
     VkResult r = vkEnumeratePhysicalDevices(st->instance, &n, devs);
@@ -242,7 +242,7 @@ static rc_status pick_device(rc__vk_state *st)
         if (end != want && *end == '\0') {
             if (idx >= n)
                 return rc__fail(st->ctx, RC_ERR_UNSUPPORTED,
-                                "vulkan: RANGECAST_VULKAN_DEVICE=%s but there are %u devices (%s)", want, (unsigned)n,
+                                "vulkan: device \"%s\" (rc_context_desc.device or RANGECAST_VULKAN_DEVICE) but there are %u devices (%s)", want, (unsigned)n,
                                 names);
             best = (int)idx;
         } else {
@@ -250,7 +250,7 @@ static rc_status pick_device(rc__vk_state *st)
                 if (contains_nocase(props[i].deviceName, want)) best = (int)i;
             if (best < 0)
                 return rc__fail(st->ctx, RC_ERR_UNSUPPORTED,
-                                "vulkan: RANGECAST_VULKAN_DEVICE=%s matches no device (%s)", want, names);
+                                "vulkan: device \"%s\" (rc_context_desc.device or RANGECAST_VULKAN_DEVICE) matches no device (%s)", want, names);
         }
         if (props[best].apiVersion < VK_API_VERSION_1_1 || !compute_family(devs[best], &family))
             return rc__fail(st->ctx, RC_ERR_UNSUPPORTED,

@@ -89,6 +89,7 @@ typedef struct rc__vk_sensor_slot {
 
 typedef struct rc__vk_state {
     rc_context *ctx;
+    const char *want_device;  /* rc_context_desc.device, during init only */
     VkAllocationCallbacks alloc;
     uint64_t host_bytes;     /* bytes the driver holds through our callbacks */
     uint64_t device_bytes;   /* bytes of VkDeviceMemory we hold, all kinds */

@@ -37,6 +37,7 @@ static void usage(FILE *f)
         "  --poses FILE       raw poses: float32 LE x y z qx qy qz qw per pose\n"
         "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40\n"
         "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
+        "  --device NAME      vulkan: device index or name substring (default: first GPU, else any)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
@@ -202,6 +203,9 @@ static int parse_args(int argc, char **argv, bench_args *a)
             } else if (rcp_parse_backend(cmd, v, &a->backend) != 0) {
                 return -1;
             }
+        } else if (OPT("--device")) {
+            if (r < 0) return -1;
+            rcp_device = v;
         } else if (OPT("--threads")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &a->threads) != 0 || a->threads > RC_MAX_THREADS)

@@ -196,6 +196,7 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
     rc_status st;
     uint32_t k;
     cd.backend = backend;
+    cd.device = rcp_device;
     cd.thread_count = threads;
     if ((st = rc_context_memory_requirements(&cd, &ctx_bytes)) != RC_OK)
         return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
@@ -248,6 +249,8 @@ void rcp_world_destroy(rcp_world *world)
     memset(world, 0, sizeof *world);
 }
 
+const char *rcp_device = NULL;
+
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *w)
 {
@@ -261,6 +264,7 @@ int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const 
                         &w->scene_bytes) != RCP_EXIT_OK)
         return RCP_EXIT_FAIL;
     cd.backend = backend;
+    cd.device = rcp_device;
     cd.thread_count = threads;
     cd.memory = NULL;             /* the library mallocs exactly this much, once */
     cd.memory_size = w->arena_bytes;

@@ -71,6 +71,9 @@ typedef struct rcp_world {
 
 /* Creates the world; on failure prints the error (as cmd) and returns
  * RCP_EXIT_FAIL with *world cleaned up. */
+/* --device of bench/simulate: the Vulkan device (rc_context_desc.device); NULL = default. */
+extern const char *rcp_device;
+
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *world);
 void rcp_world_destroy(rcp_world *world);
