@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "rc_test.h"
+#include "reference.h"
 
 #define DEG (3.14159265358979323846 / 180.0)
 
@@ -15,6 +16,16 @@ static uint32_t backend_of(void **state) { return *(const uint32_t *)*state; }
     do {                                      \
         if (!rct_backend_usable(b)) skip();   \
     } while (0)
+
+/* Rotation of a pose in double (the float64 reference's transform). */
+static void pose_rotation(const rc_pose *pose, double R[9])
+{
+    rcu_xform x;
+    int i, j;
+    rcu_xform_from_pose(pose, &x);
+    for (i = 0; i < 3; ++i)
+        for (j = 0; j < 3; ++j) R[3 * i + j] = x.r[i][j];
+}
 
 /* A wall: the plane x = d, a big square, normal -x. */
 static void wall_mesh(float d, rcu_mesh *m)
@@ -117,17 +128,8 @@ static void test_box_room_vlp16(void **state)
     assert_int_equal(rc_preset_spherical(RC_PRESET_VELODYNE_VLP16, &sd), RC_OK);
     {
         /* world rotation of the pose, in double */
-        double q[4] = {pose.orientation[0], pose.orientation[1], pose.orientation[2], pose.orientation[3]};
         double R[9], o[3] = {pose.position[0], pose.position[1], pose.position[2]};
-        R[0] = 1 - 2 * (q[1] * q[1] + q[2] * q[2]);
-        R[1] = 2 * (q[0] * q[1] - q[2] * q[3]);
-        R[2] = 2 * (q[0] * q[2] + q[1] * q[3]);
-        R[3] = 2 * (q[0] * q[1] + q[2] * q[3]);
-        R[4] = 1 - 2 * (q[0] * q[0] + q[2] * q[2]);
-        R[5] = 2 * (q[1] * q[2] - q[0] * q[3]);
-        R[6] = 2 * (q[0] * q[2] - q[1] * q[3]);
-        R[7] = 2 * (q[1] * q[2] + q[0] * q[3]);
-        R[8] = 1 - 2 * (q[0] * q[0] + q[1] * q[1]);
+        pose_rotation(&pose, R);
         for (r = 0; r < 16; ++r)
             for (c = 0; c < 900; ++c) {
                 uint32_t k = r * 900 + c;
@@ -183,19 +185,10 @@ static void test_inside_sphere(void **state)
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, 3, &buf.res));
     for (p = 0; p < 3; ++p) {
         rc_spherical_desc sd;
-        double q[4], R[9], o[3];
+        double R[9], o[3];
         assert_int_equal(rc_preset_spherical(RC_PRESET_VELODYNE_VLP16_360, &sd), RC_OK);
-        for (i = 0; i < 4; ++i) q[i] = poses[p].orientation[i];
         for (i = 0; i < 3; ++i) o[i] = poses[p].position[i];
-        R[0] = 1 - 2 * (q[1] * q[1] + q[2] * q[2]);
-        R[1] = 2 * (q[0] * q[1] - q[2] * q[3]);
-        R[2] = 2 * (q[0] * q[2] + q[1] * q[3]);
-        R[3] = 2 * (q[0] * q[1] + q[2] * q[3]);
-        R[4] = 1 - 2 * (q[0] * q[0] + q[2] * q[2]);
-        R[5] = 2 * (q[1] * q[2] - q[0] * q[3]);
-        R[6] = 2 * (q[0] * q[2] - q[1] * q[3]);
-        R[7] = 2 * (q[1] * q[2] + q[0] * q[3]);
-        R[8] = 1 - 2 * (q[0] * q[0] + q[1] * q[1]);
+        pose_rotation(&poses[p], R);
         for (i = 0; i < rays; ++i) {
             uint32_t k = p * rays + i, r = i / 360, c = i % 360, prim;
             double th = sd.theta.min + c * (double)sd.theta.increment, ph = sd.phi.min + r * (double)sd.phi.increment;
