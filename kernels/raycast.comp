@@ -427,7 +427,7 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
                 alive = false;
                 while (sp > 0u && !alive) {
                     --sp;
-                    if (stk_t[sp] <= h.t) {
+                    if (stk_t[sp] <= h.t * 1.0000020) { /* the box test's slack: ties are never culled */
                         n = load_node(g.node_base + stk_n[sp]);
                         alive = true;
                     }
@@ -452,7 +452,7 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
         alive = false;
         while (sp > 0u && !alive) {
             --sp;
-            if (stk_t[sp] <= h.t) {
+            if (stk_t[sp] <= h.t * 1.0000020) { /* the box test's slack: ties are never culled */
                 n = load_node(g.node_base + stk_n[sp]);
                 alive = true;
             }

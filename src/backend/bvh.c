@@ -1,4 +1,5 @@
-/* The built-in backend: the scene's two-level BVH, traversed on the CPU by the
+/* The built-in backend: the scene's two-level BVH (4-wide mesh trees,
+ * bvh/wide.h), traversed on the CPU by the
  * context's thread pool. Rays of a scan are traced in tiles (neighbouring rows
  * and columns of a grid sensor, or runs of consecutive O1Dn rays) that share
  * the sensor's origin, so the packet traversal serves a tile per node fetch.
@@ -170,11 +171,11 @@ static rc_status bvh_init(rc_context *ctx, const rc_context_desc *desc)
 static void bvh_deinit(rc_context *ctx) { (void)ctx; }
 static rc_status bvh_commit(rc_scene *scene, rc_progress_fn progress, void *user)
 {
-    return rc__scene_build_bvh(scene, progress, user);
+    return rc__scene_build_wide(scene, progress, user);
 }
 
 const rc__backend rc__backend_bvh = {
-    RC_BACKEND_BVH,   "bvh",      bvh_available, bvh_context_bytes, rc__scene_bvh_commit_bytes,
+    RC_BACKEND_BVH,   "bvh",      bvh_available, bvh_context_bytes, rc__scene_wide_commit_bytes,
     bvh_init,         bvh_deinit, bvh_commit,    NULL,              bvh_simulate,
     NULL,
 };

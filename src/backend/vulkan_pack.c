@@ -228,7 +228,7 @@ static int packed_mesh(const rc__vk_packed *p, uint32_t gi, uint32_t geom_id, ui
         for (;;) {
             if (sp == 0) return found;
             --sp;
-            if (stack[sp].tnear <= hit->t) {
+            if (stack[sp].tnear <= hit->t * RC__SLAB_FAR_SCALE) { /* ties are never culled */
                 ni = stack[sp].node;
                 break;
             }

@@ -178,14 +178,7 @@ static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *r
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (t > tcur) continue;
-                if (t == tcur && !rc__hit_key_less(inst, geom, prim, hit)) continue;
-                hit->t = t;
-                hit->u = u;
-                hit->v = v;
-                hit->prim = prim;
-                hit->geom = geom;
-                hit->inst = inst;
+                if (!rc__hit_offer(hit, t, u, v, prim, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }
@@ -193,7 +186,9 @@ static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *r
         for (;;) {
             if (sp == 0) return found;
             --sp;
-            if (stack[sp].tnear <= tcur) {
+            /* with the box test's slack: a box whose entry distance rounds
+             * just above t may still hold a triangle at t (a tie) */
+            if (stack[sp].tnear <= tcur * RC__SLAB_FAR_SCALE) {
                 index = stack[sp].index;
                 count = stack[sp].count;
                 break;
@@ -205,10 +200,12 @@ static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *r
 int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                        rc__hit *hit)
 {
+    if (mesh->wide) return rc__mesh_intersect_wide(mesh, ray, geom, inst, hit);
     return rc__traverse(mesh, ray, geom, inst, hit, hit->t, 0);
 }
 
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax)
 {
+    if (mesh->wide) return rc__mesh_occluded_wide(mesh, ray, tmax);
     return rc__traverse(mesh, ray, 0, 0, NULL, tmax, 1);
 }

@@ -4,6 +4,7 @@
 #define RC_BVH_MESH_H
 
 #include "bvh/bvh.h"
+#include "bvh/wide.h"
 
 #include <stdint.h>
 
@@ -19,6 +20,12 @@ typedef struct rc__mesh {
      * slot), so a leaf's triangles are one contiguous read instead of one
      * dependent miss each; NULL until the scene's commit fills it. */
     const uint32_t *leaf_tris;
+    /* The 4-wide tree the CPU traverses (wide.h), when the backend built one
+     * (the built-in backend does; the Vulkan backend keeps the binary tree,
+     * which is then in bvh.nodes). Its leaves index bvh.refs and leaf_tris. */
+    const rc__wnode *wide;
+    uint32_t wide_count;
+    uint32_t reserved1;
 } rc__mesh;
 
 /* A ray prepared for traversal: origin, direction (any length, not zero),
@@ -53,6 +60,16 @@ void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);
  * arguments) and returns 1; else 0. */
 int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                        rc__hit *hit);
+
+/* The same searches over the 4-wide tree (wide_trace.c); rc__mesh_intersect
+ * and rc__mesh_occluded take this path when mesh->wide is set. */
+int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
+                            rc__hit *hit);
+int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
+/* Nearest-hit search of the subtree under wide node `node` only (the packet
+ * traversal hands a lane over when its packet has thinned out). */
+int rc__mesh_intersect_wide_from(const rc__mesh *mesh, uint32_t node, const rc__ray *ray, uint32_t geom,
+                                 uint32_t inst, rc__hit *hit);
 
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);

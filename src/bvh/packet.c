@@ -1,4 +1,4 @@
-/* Packet traversal over the canonical BVH (see packet.h).
+/* Packet traversal over the 4-wide BVH (see packet.h and wide.h).
  *
  * A packet runs only when all its rays lie in one octant (the same sign of
  * each direction component), which holds for every tile of a scan but those
@@ -26,15 +26,21 @@
 #define GROUPS (LANES / 4u)
 
 typedef struct packet_entry {
-    uint32_t node;
-    uint32_t mask; /* lanes that met this node's box when it was pushed */
+    uint32_t child;
+    uint32_t count; /* 0: a node; else a leaf's triangle count */
+    uint32_t mask;  /* lanes that met its box when it was pushed */
+    float tmin;     /* smallest entry distance of those lanes (ordering only) */
 } packet_entry;
+
+/* A node reached by at most this many lanes is finished ray by ray: below
+ * that, the packet's shared fetch no longer pays for its 16-lane tests. */
+#define SINGLE_BELOW 2u
 
 /* Per-lane slab data, 16-byte aligned rows of 4 lanes. */
 typedef struct packet_lanes {
     float ix[LANES], iy[LANES], iz[LANES];
     float tmax[LANES];
-    uint32_t near_off[3];  /* byte offset of the near plane per axis: 0 (bmin) or 16 (bmax) */
+    uint32_t near_row[3];  /* plane row of a wide node each axis enters by (wide.h) */
     float org[3];
 } packet_lanes;
 
@@ -46,14 +52,15 @@ typedef struct packet_lanes {
 
 /* Lanes of `mask` whose ray meets the box within [0, tmax]; *tmin_out gets a
  * lower bound of their entry distances (for ordering only). */
-static inline uint32_t box_mask(const rc__bvh_node *n, const packet_lanes *L, uint32_t mask, float *tmin_out)
+static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask,
+                                float *tmin_out)
 {
-    const float nx = rc__node_plane(n, L->near_off[0]) - L->org[0];
-    const float ny = rc__node_plane(n, L->near_off[1]) - L->org[1];
-    const float nz = rc__node_plane(n, L->near_off[2]) - L->org[2];
-    const float fx = rc__node_plane(n, L->near_off[0] ^ 16u) - L->org[0];
-    const float fy = rc__node_plane(n, L->near_off[1] ^ 16u) - L->org[1];
-    const float fz = rc__node_plane(n, L->near_off[2] ^ 16u) - L->org[2];
+    const float nx = n->box[L->near_row[0]][c] - L->org[0];
+    const float ny = n->box[L->near_row[1]][c] - L->org[1];
+    const float nz = n->box[L->near_row[2]][c] - L->org[2];
+    const float fx = n->box[L->near_row[0] ^ 1u][c] - L->org[0];
+    const float fy = n->box[L->near_row[1] ^ 1u][c] - L->org[1];
+    const float fz = n->box[L->near_row[2] ^ 1u][c] - L->org[2];
     uint32_t out = 0, g;
 #if defined(RC__PACKET_SSE2)
     const __m128 vnx = _mm_set1_ps(nx), vny = _mm_set1_ps(ny), vnz = _mm_set1_ps(nz);
@@ -148,14 +155,14 @@ static inline uint32_t box_mask(const rc__bvh_node *n, const packet_lanes *L, ui
 
 /* 1 when every ray of the packet has the same direction signs (by the sign of
  * its reciprocal, so -0 counts as negative, as in the single-ray test). */
-static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_off[3])
+static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_row[3])
 {
     uint32_t i, k;
     for (k = 0; k < 3; ++k) {
         const int neg = rays[0].inv_dir[k] < 0.0f;
         for (i = 1; i < n; ++i)
             if ((rays[i].inv_dir[k] < 0.0f) != neg) return 0;
-        near_off[k] = 4u * k + (neg ? 16u : 0u); /* bmin at 0, bmax at 16 */
+        near_row[k] = 2u * k + (neg ? 1u : 0u);
     }
     return 1;
 }
@@ -200,26 +207,33 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
     }
 }
 
+static uint32_t popcount16(uint32_t m)
+{
+    uint32_t n = 0;
+    for (; m; m &= m - 1u) ++n;
+    return n;
+}
+
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
                                uint32_t inst, rc__hit *hits, int *found)
 {
-    const rc__bvh_node *nodes = mesh->bvh.nodes;
+    const rc__wnode *nodes = mesh->wide;
     const uint32_t *refs = mesh->bvh.refs;
-    const uint32_t *indices = mesh->indices;
     const uint32_t *leaf_tris = mesh->leaf_tris;
     const float *vertices = mesh->vertices;
     const size_t stride = mesh->stride;
     packet_lanes L RC__ALIGN16;
-    packet_entry stack[RC__BVH_MAX_DEPTH + 1];
-    uint32_t sp = 0, i, node = 0, mask;
-    float tdummy;
+    /* up to three pushes per level */
+    packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
+    uint32_t sp = 0, i, child = 0, count = 0, mask;
 
-    if (n == 0 || mesh->bvh.node_count == 0) return;
-    if (n > LANES) {
+    if (n == 0) return;
+    if (n > LANES || nodes == NULL) {
         for (i = 0; i < n; ++i) found[i] |= rc__mesh_intersect(mesh, &rays[i], geom, inst, &hits[i]);
         return;
     }
-    if (!one_octant(rays, n, L.near_off)) {
+    if (mesh->wide_count == 0) return;
+    if (!one_octant(rays, n, L.near_row)) {
         split_by_octant(mesh, rays, n, geom, inst, hits, found);
         return;
     }
@@ -231,40 +245,55 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
         L.iz[i] = r->inv_dir[2];
         L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
     }
-    mask = box_mask(&nodes[0], &L, (n >= 32u ? 0u : (1u << n)) - 1u, &tdummy);
-    while (mask) {
-        const rc__bvh_node *nd = &nodes[node];
-        if (nd->count == 0) {
-            float t0, t1;
-            const uint32_t m0 = box_mask(&nodes[nd->index], &L, mask, &t0);
-            const uint32_t m1 = box_mask(&nodes[nd->index + 1], &L, mask, &t1);
-            if (m0 && m1) {
-                /* nearer child first (by the packet's smallest entry) */
-                if (t1 < t0) {
-                    stack[sp].node = nd->index;
-                    stack[sp].mask = m0;
-                    node = nd->index + 1;
-                    mask = m1;
-                } else {
-                    stack[sp].node = nd->index + 1;
-                    stack[sp].mask = m1;
-                    node = nd->index;
-                    mask = m0;
+    mask = (n >= 32u ? 0u : (1u << n)) - 1u;
+    for (;;) {
+        if (count == 0 && popcount16(mask) <= SINGLE_BELOW) {
+            /* thinned out: the lanes left finish this subtree alone */
+            uint32_t m = mask;
+            while (m) {
+                uint32_t lane = 0;
+                while (!((m >> lane) & 1u)) ++lane;
+                m &= m - 1u;
+                hits[lane].t = L.tmax[lane];
+                if (rc__mesh_intersect_wide_from(mesh, child, &rays[lane], geom, inst, &hits[lane])) {
+                    L.tmax[lane] = hits[lane].t;
+                    found[lane] = 1;
                 }
-                ++sp; /* depth is capped by the builder */
-                continue;
             }
-            if (m0 | m1) {
-                node = m0 ? nd->index : nd->index + 1;
-                mask = m0 | m1;
+        } else if (count == 0) {
+            const rc__wnode *nd = &nodes[child];
+            packet_entry e[4];
+            uint32_t m = 0, c, j;
+            for (c = 0; c < 4; ++c) {
+                float t;
+                uint32_t mc;
+                if (nd->child[c] == RC__WIDE_EMPTY) continue;
+                mc = box_mask(nd, c, &L, mask, &t);
+                if (!mc) continue;
+                e[m].child = nd->child[c];
+                e[m].count = nd->count[c];
+                e[m].mask = mc;
+                e[m].tmin = t;
+                /* keep e sorted by the packet's smallest entry distance */
+                for (j = m; j > 0 && e[j].tmin < e[j - 1].tmin; --j) {
+                    const packet_entry tmp = e[j];
+                    e[j] = e[j - 1];
+                    e[j - 1] = tmp;
+                }
+                ++m;
+            }
+            if (m > 0) {
+                for (j = m; j-- > 1;) stack[sp++] = e[j]; /* depth is capped by the builder */
+                child = e[0].child;
+                count = e[0].count;
+                mask = e[0].mask;
                 continue;
             }
         } else {
-            const uint32_t end = nd->index + nd->count;
+            const uint32_t end = child + count;
             uint32_t j;
-            for (j = nd->index; j < end; ++j) {
-                const uint32_t prim = refs[j];
-                const uint32_t *tri = leaf_tris ? leaf_tris + (size_t)3 * j : indices + (size_t)3 * prim;
+            for (j = child; j < end; ++j) {
+                const uint32_t *tri = leaf_tris + (size_t)3 * j;
                 const float *a = vertices + tri[0] * stride, *b = vertices + tri[1] * stride;
                 const float *c = vertices + tri[2] * stride;
                 uint32_t m = mask;
@@ -274,24 +303,18 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                     while (!((m >> lane) & 1u)) ++lane;
                     m &= m - 1u;
                     if (!rc__tri_intersect(&rays[lane], a, b, c, &t, &u, &v)) continue;
-                    if (t > hits[lane].t) continue;
-                    if (t == hits[lane].t && !rc__hit_key_less(inst, geom, prim, &hits[lane])) continue;
-                    hits[lane].t = t;
-                    hits[lane].u = u;
-                    hits[lane].v = v;
-                    hits[lane].prim = prim;
-                    hits[lane].geom = geom;
-                    hits[lane].inst = inst;
+                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[j], geom, inst)) continue;
                     L.tmax[lane] = t;
                     found[lane] = 1;
                 }
             }
         }
-        /* pop, dropping entries all of whose lanes have since found nearer hits
-         * is left to the box tests below them (tmax per lane) */
+        /* pop; lanes that have since found nearer hits drop out in the box
+         * tests below (tmax per lane) */
         if (sp == 0) break;
         --sp;
-        node = stack[sp].node;
+        child = stack[sp].child;
+        count = stack[sp].count;
         mask = stack[sp].mask;
     }
 }

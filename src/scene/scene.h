@@ -47,6 +47,7 @@ struct rc_scene {
     uint64_t *source_versions;/* per instance: source->version seen at the last commit */
     rc__bvh top;              /* items: geometries 0..geom_count-1, then instances */
     void *top_block;
+    size_t accel_block_bytes; /* top_block's payload as kept after commit */
     rc__aabb bounds;
     void *backend_scene;      /* backend's own state (Embree scene, Vulkan buffers) */
 };
@@ -61,6 +62,10 @@ size_t rc__scene_object_bytes(const rc_scene_desc *desc);
  * (which uploads it). Exact peak arena use: rc__scene_bvh_commit_bytes. */
 rc_status rc__scene_build_bvh(rc_scene *scene, rc_progress_fn progress, void *user);
 size_t rc__scene_bvh_commit_bytes(const rc_scene_desc *desc);
+/* The same with each mesh's tree collapsed to 4-wide nodes (bvh/wide.h), for
+ * the built-in backend; the binary mesh trees exist only during commit. */
+rc_status rc__scene_build_wide(rc_scene *scene, rc_progress_fn progress, void *user);
+size_t rc__scene_wide_commit_bytes(const rc_scene_desc *desc);
 void rc__scene_release_bvh(rc_scene *scene);
 
 /* 1 when every instance's source is committed at the version seen at our commit. */

@@ -1,0 +1,238 @@
+/* Single-ray nearest-hit and any-hit traversal of the 4-wide BVH (wide.h).
+ *
+ * Each step fetches one node and meets the ray with its four child boxes at
+ * once: SSE2 on x86-64, NEON on ARM, a plain loop elsewhere (or with
+ * RC__WIDE_FORCE_SCALAR, for tests and instruction counts). The slab test is
+ * the robust one of intersect.h lane by lane, so the wide and binary trees
+ * cull exactly as conservatively: both test the triangles that can matter
+ * with the same watertight test and tie rule, and give the same hit, bit for
+ * bit. Children met are visited nearest first; the others wait on a stack
+ * with their entry distance and are dropped once a nearer hit is known. */
+#include "bvh/mesh.h"
+
+#include "bvh/intersect.h"
+#include "core/common.h"
+
+#if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
+#include <emmintrin.h>
+#define RC__WIDE_SSE2 1
+#elif defined(__ARM_NEON) && !defined(RC__WIDE_FORCE_SCALAR)
+#include <arm_neon.h>
+#define RC__WIDE_NEON 1
+#endif
+
+#if defined(__GNUC__)
+#define RC__WALWAYS inline __attribute__((always_inline))
+#define RC__WALIGN16 __attribute__((aligned(16)))
+#else
+#define RC__WALWAYS inline
+#define RC__WALIGN16
+#endif
+
+/* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
+#define STACK_SIZE (3u * RC__BVH_MAX_DEPTH + 4u)
+
+typedef struct wide_entry {
+    uint32_t child;
+    uint32_t count;
+    float tnear;
+} wide_entry;
+
+/* Per-ray constants: origin and reciprocal direction splatted, and which
+ * plane row (0..5) of a node each axis enters by. */
+typedef struct wide_ray {
+    float org[3];
+    float inv[3];
+    uint32_t near_row[3];
+} wide_ray;
+
+static void wide_ray_init(wide_ray *w, const rc__ray *r)
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        w->org[k] = r->org[k];
+        w->inv[k] = r->inv_dir[k];
+        /* -0 counts as negative, as in rc__slab_ray_init */
+        w->near_row[k] = 2u * (uint32_t)k + (r->inv_dir[k] < 0.0f ? 1u : 0u);
+    }
+}
+
+/* Bit c set when the ray meets child c's box within [0, tmax]
+ * (conservatively, Ize's bound); tn[c] gets the entry distance. */
+static RC__WALWAYS uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w, float tmax, float tn[4])
+{
+    const float *nx = n->box[w->near_row[0]], *fx = n->box[w->near_row[0] ^ 1u];
+    const float *ny = n->box[w->near_row[1]], *fy = n->box[w->near_row[1] ^ 1u];
+    const float *nz = n->box[w->near_row[2]], *fz = n->box[w->near_row[2] ^ 1u];
+#if defined(RC__WIDE_SSE2)
+    const __m128 ox = _mm_set1_ps(w->org[0]), oy = _mm_set1_ps(w->org[1]), oz = _mm_set1_ps(w->org[2]);
+    const __m128 ix = _mm_set1_ps(w->inv[0]), iy = _mm_set1_ps(w->inv[1]), iz = _mm_set1_ps(w->inv[2]);
+    /* max/min return the second operand when the first is NaN (0 * inf: the
+     * origin on a plane of a parallel ray): such a plane imposes nothing */
+    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nx), ox), ix), _mm_setzero_ps());
+    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fx), ox), ix), _mm_set1_ps(tmax));
+    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ny), oy), iy), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fy), oy), iy), t1);
+    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nz), oz), iz), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fz), oz), iz), t1);
+    _mm_store_ps(tn, t0);
+    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
+#elif defined(RC__WIDE_NEON)
+    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
+    const float32x4_t ox = vdupq_n_f32(w->org[0]), oy = vdupq_n_f32(w->org[1]), oz = vdupq_n_f32(w->org[2]);
+    const float32x4_t ix = vdupq_n_f32(w->inv[0]), iy = vdupq_n_f32(w->inv[1]), iz = vdupq_n_f32(w->inv[2]);
+    float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(tmax), a;
+    uint32x4_t h;
+    uint32x2_t s2;
+    /* "a > b ? a : b" (NEON's max would let a NaN through) */
+    a = vmulq_f32(vsubq_f32(vld1q_f32(nx), ox), ix);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(ny), oy), iy);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(nz), oz), iz);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fx), ox), ix);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fy), oy), iy);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fz), oz), iz);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    vst1q_f32(tn, t0);
+    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
+    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
+    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+#else
+    uint32_t mask = 0;
+    int c;
+    for (c = 0; c < 4; ++c) {
+        const float ax = (nx[c] - w->org[0]) * w->inv[0], ay = (ny[c] - w->org[1]) * w->inv[1];
+        const float az = (nz[c] - w->org[2]) * w->inv[2];
+        const float bx = (fx[c] - w->org[0]) * w->inv[0], by = (fy[c] - w->org[1]) * w->inv[1];
+        const float bz = (fz[c] - w->org[2]) * w->inv[2];
+        float t0 = 0.0f, t1 = tmax;
+        t0 = ax > t0 ? ax : t0;
+        t0 = ay > t0 ? ay : t0;
+        t0 = az > t0 ? az : t0;
+        t1 = bx < t1 ? bx : t1;
+        t1 = by < t1 ? by : t1;
+        t1 = bz < t1 ? bz : t1;
+        tn[c] = t0;
+        if (t0 <= t1 * RC__SLAB_FAR_SCALE) mask |= 1u << c;
+    }
+    return mask;
+#endif
+}
+
+static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, uint32_t start, const rc__ray *ray, uint32_t geom,
+                                     uint32_t inst, rc__hit *hit, float tmax, int any_hit)
+{
+    const rc__wnode *nodes = mesh->wide;
+    const uint32_t *refs = mesh->bvh.refs;
+    const uint32_t *leaf_tris = mesh->leaf_tris;
+    const float *vertices = mesh->vertices;
+    const size_t stride = mesh->stride;
+    const rc__ray r = *ray;
+    wide_ray w;
+    wide_entry stack[STACK_SIZE];
+    uint32_t sp = 0, child = start, count = 0;
+    float tcur = tmax;
+    int found = 0;
+
+    if (mesh->wide_count == 0) return 0;
+    wide_ray_init(&w, &r);
+    for (;;) {
+        if (count == 0) {
+            const rc__wnode *n = &nodes[child];
+            float tn[4] RC__WALIGN16;
+            uint32_t mask = wide_box_test(n, &w, tcur, tn);
+            if (mask == 0) goto pop;
+            {
+                uint32_t c = 0;
+                while (!((mask >> c) & 1u)) ++c;
+                mask &= mask - 1u;
+                if (mask == 0) { /* one child met: no ordering, no push */
+                    child = n->child[c];
+                    count = n->count[c];
+                    continue;
+                }
+                {
+                    /* two to four met: sort by entry distance, push all but
+                     * the nearest farthest-first, visit the nearest */
+                    wide_entry e[4];
+                    uint32_t m = 0, i, j;
+                    e[m].child = n->child[c];
+                    e[m].count = n->count[c];
+                    e[m].tnear = tn[c];
+                    ++m;
+                    while (mask) {
+                        c = 0;
+                        while (!((mask >> c) & 1u)) ++c;
+                        mask &= mask - 1u;
+                        e[m].child = n->child[c];
+                        e[m].count = n->count[c];
+                        e[m].tnear = tn[c];
+                        for (i = m; i > 0 && e[i].tnear < e[i - 1].tnear; --i) {
+                            const wide_entry t = e[i];
+                            e[i] = e[i - 1];
+                            e[i - 1] = t;
+                        }
+                        ++m;
+                    }
+                    for (j = m; j-- > 1;) {
+                        /* the builder caps depth so this always holds; a
+                         * corrupt tree loses branches instead of the stack */
+                        if (RC__LIKELY(sp < STACK_SIZE)) stack[sp++] = e[j];
+                    }
+                    child = e[0].child;
+                    count = e[0].count;
+                    continue;
+                }
+            }
+        } else {
+            const uint32_t end = child + count;
+            uint32_t j;
+            for (j = child; j < end; ++j) {
+                const uint32_t *tri = leaf_tris + (size_t)3 * j;
+                float t, u, v;
+                if (!rc__tri_intersect(&r, vertices + tri[0] * stride, vertices + tri[1] * stride,
+                                       vertices + tri[2] * stride, &t, &u, &v))
+                    continue;
+                if (any_hit) {
+                    if (t < tmax) return 1;
+                    continue;
+                }
+                if (t > tcur || !rc__hit_offer(hit, t, u, v, refs[j], geom, inst)) continue;
+                tcur = t;
+                found = 1;
+            }
+        }
+    pop:
+        for (;;) {
+            if (sp == 0) return found;
+            --sp;
+            /* with the box test's slack: a box whose entry distance rounds
+             * just above t may still hold a triangle at t (a tie) */
+            if (stack[sp].tnear <= tcur * RC__SLAB_FAR_SCALE) {
+                child = stack[sp].child;
+                count = stack[sp].count;
+                break;
+            }
+        }
+    }
+}
+
+int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst, rc__hit *hit)
+{
+    return wide_traverse(mesh, 0, ray, geom, inst, hit, hit->t, 0);
+}
+
+int rc__mesh_intersect_wide_from(const rc__mesh *mesh, uint32_t node, const rc__ray *ray, uint32_t geom,
+                                 uint32_t inst, rc__hit *hit)
+{
+    return wide_traverse(mesh, node, ray, geom, inst, hit, hit->t, 0);
+}
+
+int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax)
+{
+    return wide_traverse(mesh, 0, ray, 0, 0, NULL, tmax, 1);
+}
