@@ -1,9 +1,10 @@
 #!/bin/sh
-# Instruction counts of the packet traversal's SIMD box test, without a board:
+# Instruction counts of the SIMD box tests of the 4-wide BVH, without a board:
 # guest instructions executed under qemu-user for aarch64 (NEON), and
 # instructions executed under valgrind (callgrind Ir) for x86_64 (SSE2), each
-# against the scalar box test (-DRC__PACKET_FORCE_SCALAR) and single-ray
-# traversal (-DRANGECAST_NO_PACKETS), on one fixed workload
+# against the plain-C box tests (-DRC__PACKET_FORCE_SCALAR
+# -DRC__WIDE_FORCE_SCALAR) and against single rays without packets
+# (-DRANGECAST_NO_PACKETS, SIMD box tests), on one fixed workload
 # (tools/neon-workload.c: 9,800-triangle UV sphere, 2 VLP-16 scans, 1 thread).
 #
 #   sh tools/neon-icount.sh            both targets
@@ -31,7 +32,7 @@ log() { echo "neon-icount: $*" >&2; }
 variant_flags() {
     case $1 in
     simd) echo "" ;;
-    scalar) echo "-DRC__PACKET_FORCE_SCALAR" ;;
+    scalar) echo "-DRC__PACKET_FORCE_SCALAR -DRC__WIDE_FORCE_SCALAR" ;;
     single) echo "-DRANGECAST_NO_PACKETS" ;;
     esac
 }

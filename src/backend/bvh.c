@@ -83,7 +83,7 @@ static void hit_reset(rc__hit *hit, float tmax)
 {
     hit->t = tmax;
     hit->u = hit->v = 0.0f;
-    hit->prim = hit->geom = hit->inst = RC_INVALID_ID;
+    hit->prim = hit->geom = hit->inst = hit->slot = RC_INVALID_ID;
 }
 
 static void trace_task(void *user, uint32_t task, uint32_t thread)

@@ -94,6 +94,7 @@ static inline void finish(const trace_run *run, const rc__xformf *world, uint64_
         hit.v = v;
         hit.geom = geom;
         hit.prim = prim;
+        hit.slot = RC_INVALID_ID; /* Embree's own order */
         hit.inst = inst == RTC_INVALID_GEOMETRY_ID ? RC_INVALID_ID : inst - run->es->max_geoms;
         if (run->dups) {
             const rc__emb_scene *src = run->es;
@@ -104,7 +105,7 @@ static inline void finish(const trace_run *run, const rc__xformf *world, uint64_
     } else {
         hit.t = INFINITY;
         hit.u = hit.v = 0.0f;
-        hit.prim = hit.geom = hit.inst = RC_INVALID_ID;
+        hit.prim = hit.geom = hit.inst = hit.slot = RC_INVALID_ID;
     }
     rc__write_result(job, base + r, ds, os, found, &hit, NULL, world);
 }

@@ -220,6 +220,7 @@ static int packed_mesh(const rc__vk_packed *p, uint32_t gi, uint32_t geom_id, ui
                 hit->u = u;
                 hit->v = v;
                 hit->prim = prim;
+                hit->slot = RC_INVALID_ID;
                 hit->geom = geom_id;
                 hit->inst = inst;
                 found = 1;

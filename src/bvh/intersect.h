@@ -223,13 +223,15 @@ static inline int rc__hit_key_less(uint32_t inst, uint32_t geom, uint32_t prim, 
 
 /* Records (t, u, v) on triangle prim as the nearest hit when it beats *h:
  * nearer, or as near with a smaller key. Returns 1 when it did. */
-static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t geom, uint32_t inst)
+static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot, uint32_t geom,
+                                uint32_t inst)
 {
     if (t > h->t || (t == h->t && !rc__hit_key_less(inst, geom, prim, h))) return 0;
     h->t = t;
     h->u = u;
     h->v = v;
     h->prim = prim;
+    h->slot = slot;
     h->geom = geom;
     h->inst = inst;
     return 1;

@@ -178,7 +178,7 @@ static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *r
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (!rc__hit_offer(hit, t, u, v, prim, geom, inst)) continue;
+                if (!rc__hit_offer(hit, t, u, v, prim, j, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }

@@ -46,6 +46,8 @@ typedef struct rc__hit {
     uint32_t prim;     /* triangle index within its mesh */
     uint32_t geom;     /* geometry id within its scene */
     uint32_t inst;     /* instance id or RC_INVALID_ID */
+    uint32_t slot;     /* prim's leaf-order slot in its mesh (bvh.refs, leaf_tris): a
+                        * cached read of its vertex indices; RC_INVALID_ID if unknown */
 } rc__hit;
 
 void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3]);

@@ -303,7 +303,7 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                     while (!((m >> lane) & 1u)) ++lane;
                     m &= m - 1u;
                     if (!rc__tri_intersect(&rays[lane], a, b, c, &t, &u, &v)) continue;
-                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[j], geom, inst)) continue;
+                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[j], j, geom, inst)) continue;
                     L.tmax[lane] = t;
                     found[lane] = 1;
                 }

@@ -201,7 +201,7 @@ static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, uint32_t start, const
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (t > tcur || !rc__hit_offer(hit, t, u, v, refs[j], geom, inst)) continue;
+                if (t > tcur || !rc__hit_offer(hit, t, u, v, refs[j], j, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }

@@ -115,7 +115,10 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
         x = &scene->insts[hit->inst].to_world;
         mesh = &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
     }
-    tri = mesh->indices + (size_t)3 * hit->prim;
+    /* the leaf-ordered copy was just read by the triangle test (cached); the
+     * mesh's own index array is a miss on a large map */
+    tri = hit->slot != RC_INVALID_ID && mesh->leaf_tris ? mesh->leaf_tris + (size_t)3 * hit->slot
+                                                        : mesh->indices + (size_t)3 * hit->prim;
     for (i = 0; i < 3; ++i) {
         const float *p = mesh->vertices + (size_t)tri[i] * mesh->stride;
         if (x) {
