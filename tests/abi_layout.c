@@ -198,7 +198,14 @@ int main(int argc, char **argv)
     S(rc_results);
     F(rc_results, struct_size); F(rc_results, attributes); F(rc_results, capacity); F(rc_results, hits);
     F(rc_results, ranges); F(rc_results, points); F(rc_results, normals); F(rc_results, prim_ids);
-    F(rc_results, geom_ids); F(rc_results, inst_ids); F(rc_results, reserved);
+    F(rc_results, geom_ids); F(rc_results, inst_ids); F(rc_results, flags); F(rc_results, reserved);
+    end();
+
+    S(rc_device_results);
+    F(rc_device_results, struct_size); F(rc_device_results, attributes); F(rc_device_results, elements);
+    F(rc_device_results, buffer); F(rc_device_results, bytes); F(rc_device_results, offsets);
+    F(rc_device_results, instance); F(rc_device_results, physical_device); F(rc_device_results, device);
+    F(rc_device_results, queue_family); F(rc_device_results, reserved);
     end();
 
     if (argc > 1) return compare(argv[1]) || errors ? 1 : 0;

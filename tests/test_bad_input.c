@@ -75,8 +75,18 @@ static void test_simulate_bad_input(void **state)
     r.struct_size = 12;
     EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 1, &r), RC_ERR_STRUCT_SIZE, "struct_size");
     r = f->buf.res;
-    r.reserved[7] = 1;
+    r.reserved[6] = 1;
     EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 1, &r), RC_ERR_INVALID_ARGUMENT, "reserved");
+    r = f->buf.res;
+    r.flags = 0x80;
+    EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 1, &r), RC_ERR_INVALID_ARGUMENT, "flags");
+    r.flags = RC_RESULTS_ON_DEVICE; /* the built-in backend has no device */
+    EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 1, &r), RC_ERR_UNSUPPORTED, "RC_RESULTS_ON_DEVICE");
+    {
+        rc_device_results dr = rc_device_results_default();
+        EXPECT_FAIL(f, rc_context_get_device_results(f->ctx, &dr), RC_ERR_UNSUPPORTED, "no device");
+        EXPECT_FAIL(f, rc_context_get_device_results(f->ctx, NULL), RC_ERR_INVALID_ARGUMENT, "out");
+    }
     r = f->buf.res;
     r.attributes = 0;
     EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, poses, 1, &r), RC_ERR_INVALID_ARGUMENT, "attributes");

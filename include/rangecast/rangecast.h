@@ -549,10 +549,51 @@ typedef struct rc_results {
     uint32_t *prim_ids;
     uint32_t *geom_ids;
     uint32_t *inst_ids;
-    uint32_t reserved[8];
+    uint32_t flags;          /* RC_RESULTS_*; 0 = write the host buffers above */
+    uint32_t reserved[7];
 } rc_results;
 
+/* Keep the results on the device (Vulkan backend only; other backends return
+ * RC_ERR_UNSUPPORTED): the requested attributes stay in one device buffer, for
+ * Vulkan consumers that bind it directly, and nothing is copied to the host.
+ * The buffer pointers and capacity above are then ignored (may be NULL / 0).
+ * rc_context_get_device_results describes the buffer after the call. */
+#define RC_RESULTS_ON_DEVICE 0x1u
+
 RC_API rc_results rc_results_default(void);
+
+/* Where the last rc_simulate / rc_simulate_d with RC_RESULTS_ON_DEVICE left its
+ * results. The buffer holds one array per requested attribute, element k =
+ * pose * rays_per_scan + ray as on the host, at offsets[] (bytes; RC_ATTR_*
+ * bit order: hits, ranges, points, normals, prim, geom, inst ids; UINT64_MAX for
+ * attributes not requested). Element formats as on the host, except hits:
+ * uint32 (0 or 1) on the device. The call waited for the device, so the
+ * contents are complete; a consumer's later submission on the same device
+ * reads them after its own pipeline barrier. The buffer belongs to the
+ * context: valid until the next rc_simulate / rc_simulate_d on it or its
+ * destruction; do not free it. Handles are the Vulkan handles' values (VkBuffer
+ * is non-dispatchable; instance, physical_device and device are pointers). */
+typedef struct rc_device_results {
+    uint32_t struct_size;
+    uint32_t attributes;      /* RC_ATTR_* held */
+    uint64_t elements;        /* pose_count * rays_per_scan of that call */
+    uint64_t buffer;          /* VkBuffer */
+    uint64_t bytes;           /* bytes of the buffer the arrays span */
+    uint64_t offsets[7];
+    uint64_t instance;        /* VkInstance */
+    uint64_t physical_device; /* VkPhysicalDevice */
+    uint64_t device;          /* VkDevice */
+    uint32_t queue_family;    /* the queue family the results were written on */
+    uint32_t reserved[7];
+} rc_device_results;
+
+RC_API rc_device_results rc_device_results_default(void);
+
+/* Fills *out (out->struct_size set by the caller, as rc_device_results_default
+ * does). RC_ERR_UNSUPPORTED on a context without a device backend;
+ * RC_ERR_INVALID_ARGUMENT when no results are on the device (none simulated
+ * with RC_RESULTS_ON_DEVICE since the context's last rc_simulate). */
+RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_results *out);
 
 /* Simulates the sensor at pose_count poses (base-to-map) in a committed scene
  * and writes the requested attributes. All arguments are checked before

@@ -35,11 +35,19 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
     RC_RETURN_IF(ctx, poses == NULL && poses_d == NULL, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
     RC_RETURN_IF(ctx, pose_count == 0, RC_ERR_INVALID_ARGUMENT, "pose_count is 0");
     RC_TRY(rc__check_desc(ctx, results, (uint32_t)sizeof *results, (uint32_t)sizeof *results, "results"));
-    RC_TRY(rc__check_reserved(ctx, results->reserved, 8, "results"));
+    RC_TRY(rc__check_reserved(ctx, results->reserved, 7, "results"));
+    RC_RETURN_IF(ctx, (results->flags & ~RC_RESULTS_ON_DEVICE) != 0, RC_ERR_INVALID_ARGUMENT,
+                 "results->flags has unknown bits 0x%x", (unsigned)(results->flags & ~RC_RESULTS_ON_DEVICE));
+    RC_RETURN_IF(ctx, (results->flags & RC_RESULTS_ON_DEVICE) && ctx->backend->device_results == NULL,
+                 RC_ERR_UNSUPPORTED,
+                 "results->flags has RC_RESULTS_ON_DEVICE, but the context's backend (%s) has no device: "
+                 "results can only go to host buffers",
+                 ctx->backend->name);
     a = results->attributes;
     RC_RETURN_IF(ctx, a == 0, RC_ERR_INVALID_ARGUMENT, "results->attributes is 0: request at least one RC_ATTR_*");
     RC_RETURN_IF(ctx, (a & ~RC_ATTR_ALL) != 0, RC_ERR_INVALID_ARGUMENT,
                  "results->attributes has unknown bits 0x%x", (unsigned)(a & ~RC_ATTR_ALL));
+    if (results->flags & RC_RESULTS_ON_DEVICE) goto poses_check; /* no host buffers */
     RC_TRY(check_buffer(ctx, a, RC_ATTR_HITS, results->hits, "hits"));
     RC_TRY(check_buffer(ctx, a, RC_ATTR_RANGES, results->ranges, "ranges"));
     RC_TRY(check_buffer(ctx, a, RC_ATTR_POINTS, results->points, "points"));
@@ -51,6 +59,7 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
     RC_RETURN_IF(ctx, results->capacity < need, RC_ERR_CAPACITY,
                  "results->capacity is %llu; %u poses x %u rays need %llu", (unsigned long long)results->capacity,
                  (unsigned)pose_count, (unsigned)sensor->rays, (unsigned long long)need);
+poses_check:
     for (i = 0; i < pose_count; ++i) {
         rc_status st = poses ? rc__pose_check(&poses[i]) : rc__pose_check_d(&poses_d[i]);
         RC_RETURN_IF(ctx, st == RC_ERR_NON_FINITE, st, "poses[%u] has a NaN or infinite value", (unsigned)i);
@@ -66,6 +75,7 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
     job.pose_count = pose_count;
     job.attributes = a;
     job.out = results;
+    job.flags = results->flags;
     return ctx->backend->simulate(ctx, &job);
 }
 
@@ -87,4 +97,23 @@ rc_status rc_simulate_d(rc_context *ctx, const rc_scene *scene, const rc_sensor 
         return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT, "poses is NULL");
     }
     return simulate(ctx, scene, sensor, NULL, poses, pose_count, results);
+}
+
+rc_device_results rc_device_results_default(void)
+{
+    rc_device_results r;
+    memset(&r, 0, sizeof r);
+    r.struct_size = (uint32_t)sizeof r;
+    return r;
+}
+
+rc_status rc_context_get_device_results(rc_context *ctx, rc_device_results *out)
+{
+    if (!rc__context_valid(ctx)) return RC_ERR_INVALID_HANDLE;
+    rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, out == NULL, RC_ERR_INVALID_ARGUMENT, "out is NULL");
+    RC_TRY(rc__check_desc(ctx, out, (uint32_t)sizeof *out, (uint32_t)sizeof *out, "out"));
+    RC_RETURN_IF(ctx, ctx->backend->device_results == NULL, RC_ERR_UNSUPPORTED,
+                 "the context's backend (%s) has no device: its results are in host buffers", ctx->backend->name);
+    return ctx->backend->device_results(ctx, out);
 }

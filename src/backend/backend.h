@@ -18,6 +18,7 @@ typedef struct rc__sim_job {
     uint32_t pose_count;
     uint32_t attributes;       /* RC_ATTR_* */
     const rc_results *out;
+    uint32_t flags;            /* RC_RESULTS_* (ON_DEVICE only where device_results is set) */
 } rc__sim_job;
 
 typedef struct rc__backend {
@@ -36,6 +37,9 @@ typedef struct rc__backend {
     rc_status (*simulate)(rc_context *ctx, const rc__sim_job *job);
     /* Adds backend_bytes / device_bytes. May be NULL. */
     void (*memory_stats)(const rc_context *ctx, rc_memory_stats *stats);
+    /* Where the last RC_RESULTS_ON_DEVICE call left its results; NULL for
+     * backends without a device (they reject that flag). */
+    rc_status (*device_results)(rc_context *ctx, rc_device_results *out);
 } rc__backend;
 
 /* NULL when that backend is not compiled in. AUTO resolves to the best one present. */

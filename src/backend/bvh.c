@@ -177,5 +177,5 @@ static rc_status bvh_commit(rc_scene *scene, rc_progress_fn progress, void *user
 const rc__backend rc__backend_bvh = {
     RC_BACKEND_BVH,   "bvh",      bvh_available, bvh_context_bytes, rc__scene_wide_commit_bytes,
     bvh_init,         bvh_deinit, bvh_commit,    NULL,              bvh_simulate,
-    NULL,
+    NULL,             NULL,
 };

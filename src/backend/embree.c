@@ -253,5 +253,5 @@ static void emb_memory_stats(const rc_context *ctx, rc_memory_stats *stats)
 const rc__backend rc__backend_embree = {
     RC_BACKEND_EMBREE,     "embree",   emb_available,         emb_context_bytes, rc__emb_scene_bytes,
     emb_init,              emb_deinit, rc__emb_scene_commit,  rc__emb_scene_release,
-    rc__emb_simulate,      emb_memory_stats,
+    rc__emb_simulate,      emb_memory_stats,       NULL,
 };

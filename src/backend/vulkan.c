@@ -51,6 +51,7 @@ static void teardown(rc__vk_state *st)
         rc__vk_sensor_cache_clear(st);
         rc__vk_buffer_destroy(st, &st->xforms);
         for (i = 0; i < RC__VK_SLOTS; ++i) rc__vk_buffer_destroy(st, &st->out[i]);
+        rc__vk_buffer_destroy(st, &st->dev_out);
         rc__vk_pipelines_destroy(st);
     }
     rc__vk_device_destroy(st);
@@ -114,6 +115,7 @@ const rc__backend rc__backend_vulkan = {
     rc__vk_scene_release,
     rc__vk_simulate,
     vk_memory_stats,
+    rc__vk_device_results,
 };
 
 /* ---- test hooks --------------------------------------------------------------- */

@@ -127,6 +127,8 @@ typedef struct rc__vk_state {
     rc__vk_sensor_slot sensors[RC__VK_SENSOR_SLOTS];
     rc__vk_buffer xforms;
     rc__vk_buffer out[RC__VK_SLOTS];
+    rc__vk_buffer dev_out;   /* results kept on the device (RC_RESULTS_ON_DEVICE) */
+    rc_device_results dev_res; /* what dev_out holds; struct_size 0 when nothing valid */
     uint64_t clock;          /* use counter for the caches */
     uint32_t serial;         /* pack serial */
     uint32_t reserved0;
@@ -226,6 +228,8 @@ void rc__vk_sensor_cache_clear(rc__vk_state *st);
 rc_status rc__vk_pipelines_create(rc__vk_state *st);
 void rc__vk_pipelines_destroy(rc__vk_state *st);
 rc_status rc__vk_simulate(rc_context *ctx, const rc__sim_job *job);
+/* rc_context_get_device_results for the Vulkan backend. */
+rc_status rc__vk_device_results(rc_context *ctx, rc_device_results *out);
 
 /* vulkan.c (tests) ---------------------------------------------------------- */
 

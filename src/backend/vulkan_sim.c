@@ -257,8 +257,17 @@ static rc_status ensure_buffer(rc__vk_state *st, rc__vk_buffer *b, uint64_t byte
     return rc__vk_buffer_create(st, bytes, kind, what, b);
 }
 
+/* Handle values as the public struct carries them (pointers on some ABIs,
+ * 64-bit integers on others). */
+static uint64_t handle_bits(const void *handle, size_t size)
+{
+    uint64_t v = 0;
+    memcpy(&v, handle, size < sizeof v ? size : sizeof v);
+    return v;
+}
+
 static rc_status record_dispatch(rc__vk_state *st, uint32_t slot, VkPipeline pipe, VkDescriptorSet set,
-                                 const rc__vk_push *push, uint32_t groups_y)
+                                 const rc__vk_push *push, uint32_t groups_y, int on_device)
 {
     VkCommandBuffer cb = st->cmd[slot];
     RC_TRY(rc__vk_begin(st, slot));
@@ -269,8 +278,12 @@ static rc_status record_dispatch(rc__vk_state *st, uint32_t slot, VkPipeline pip
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, st->pipe_layout, 0, 1, &set, 0, NULL);
     vkCmdPushConstants(cb, st->pipe_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, (uint32_t)sizeof *push, push);
     vkCmdDispatch(cb, push->groups_x, groups_y, 1);
-    rc__vk_barrier(st, cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                   VK_ACCESS_HOST_READ_BIT);
+    if (on_device) /* results stay for later device work (the consumer's) */
+        rc__vk_barrier(st, cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_ALL_COMMANDS_BIT, VK_ACCESS_MEMORY_READ_BIT);
+    else
+        rc__vk_barrier(st, cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     RC__VK_TRY(st, vkEndCommandBuffer(cb), "vkEndCommandBuffer");
     return rc__vk_submit(st, slot);
 }
@@ -288,9 +301,10 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
     VkDescriptorSetAllocateInfo dai;
     VkDescriptorSetLayout layouts[RC__VK_SLOTS];
     pending pend[RC__VK_SLOTS];
-    uint32_t words = 0, a, p, slots, d;
+    uint32_t words = 0, a, p, slots, d, dev_off[7];
     uint64_t per, first;
     unsigned char *xf;
+    const int on_device = (job->flags & RC_RESULTS_ON_DEVICE) != 0;
 
     RC_RETURN_IF(st->ctx, sv == NULL || sv->refs.buf == VK_NULL_HANDLE, RC_ERR_NOT_COMMITTED,
                  "vulkan: the scene has no device copy; commit it");
@@ -338,8 +352,20 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
     if (per == 0) per = 1;
     if (per > total) per = total;
     slots = total > per ? RC__VK_SLOTS : 1u;
-    for (a = 0; a < slots; ++a)
-        RC_TRY(ensure_buffer(st, &st->out[a], per * words * 4u, st->slot_bytes, RC__VK_MEM_READBACK, "results"));
+    if (on_device) {
+        /* one array per attribute over the whole batch, in one binding */
+        const uint64_t bytes = total * words * 4u;
+        RC_RETURN_IF(st->ctx, bytes > st->max_binding, RC_ERR_CAPACITY,
+                     "vulkan: %llu elements x %u words of results on the device need %llu bytes; one binding holds "
+                     "%llu (maxStorageBufferRange): simulate fewer poses per call",
+                     (unsigned long long)total, (unsigned)words, (unsigned long long)bytes,
+                     (unsigned long long)st->max_binding);
+        RC_TRY(ensure_buffer(st, &st->dev_out, bytes, st->max_binding, RC__VK_MEM_DEVICE, "device results"));
+        sections(job->attributes, (uint32_t)total, dev_off);
+    } else {
+        for (a = 0; a < slots; ++a)
+            RC_TRY(ensure_buffer(st, &st->out[a], per * words * 4u, st->slot_bytes, RC__VK_MEM_READBACK, "results"));
+    }
 
     RC__VK_TRY(st, vkResetDescriptorPool(st->device, st->desc_pool, 0), "vkResetDescriptorPool");
     for (a = 0; a < slots; ++a) layouts[a] = st->set_layout;
@@ -349,7 +375,7 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
     dai.descriptorSetCount = slots;
     dai.pSetLayouts = layouts;
     RC__VK_TRY(st, vkAllocateDescriptorSets(st->device, &dai, sets), "vkAllocateDescriptorSets");
-    for (a = 0; a < slots; ++a) write_sets(st, sv, table, sets[a], &st->out[a]);
+    for (a = 0; a < slots; ++a) write_sets(st, sv, table, sets[a], on_device ? &st->dev_out : &st->out[a]);
 
     memset(pend, 0, sizeof pend);
     for (first = 0, d = 0; first < total; ++d) {
@@ -360,7 +386,7 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         uint32_t groups_y;
         if (pend[s].busy) {
             RC_TRY(rc__vk_wait(st, s));
-            RC_TRY(copy_out(st, job, s, &pend[s]));
+            if (!on_device) RC_TRY(copy_out(st, job, s, &pend[s]));
             pend[s].busy = 0;
         }
         memset(&push, 0, sizeof push);
@@ -378,8 +404,12 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         push.flags = sv->info.flags;
         push.groups_x = groups < lim->maxComputeWorkGroupCount[0] ? groups : lim->maxComputeWorkGroupCount[0];
         groups_y = (groups + push.groups_x - 1u) / push.groups_x;
-        sections(job->attributes, n, push.off);
-        RC_TRY(record_dispatch(st, s, pipe, sets[s], &push, groups_y));
+        if (on_device) { /* this dispatch's elements of the batch-wide arrays */
+            for (a = 0; a < 7; ++a) push.off[a] = dev_off[a] + (uint32_t)first * attr_words[a];
+        } else {
+            sections(job->attributes, n, push.off);
+        }
+        RC_TRY(record_dispatch(st, s, pipe, sets[s], &push, groups_y, on_device));
         pend[s].first = first;
         pend[s].count = n;
         pend[s].busy = 1;
@@ -389,8 +419,23 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         const uint32_t s = (d + a) % slots;
         if (!pend[s].busy) continue;
         RC_TRY(rc__vk_wait(st, s));
-        RC_TRY(copy_out(st, job, s, &pend[s]));
+        if (!on_device) RC_TRY(copy_out(st, job, s, &pend[s]));
         pend[s].busy = 0;
+    }
+    if (on_device) {
+        rc_device_results *r = &st->dev_res;
+        memset(r, 0, sizeof *r);
+        r->struct_size = (uint32_t)sizeof *r;
+        r->attributes = job->attributes;
+        r->elements = total;
+        r->buffer = handle_bits(&st->dev_out.buf, sizeof st->dev_out.buf);
+        r->bytes = total * words * 4u;
+        for (a = 0; a < 7; ++a)
+            r->offsets[a] = (job->attributes & (1u << a)) ? (uint64_t)dev_off[a] * 4u : UINT64_MAX;
+        r->instance = handle_bits(&st->instance, sizeof st->instance);
+        r->physical_device = handle_bits(&st->phys, sizeof st->phys);
+        r->device = handle_bits(&st->device, sizeof st->device);
+        r->queue_family = st->queue_family;
     }
     return RC_OK;
 }
@@ -401,9 +446,21 @@ rc_status rc__vk_simulate(rc_context *ctx, const rc__sim_job *job)
     rc_status s;
     uint32_t i;
     RC_RETURN_IF(ctx, st->lost, RC_ERR_DEVICE_LOST, "vulkan: the device was lost; destroy the context");
+    st->dev_res.struct_size = 0; /* any call may reuse or resize the device buffer */
     s = simulate(st, job);
     if (s != RC_OK) /* leave nothing in flight that writes into buffers we may free */
         for (i = 0; i < RC__VK_SLOTS; ++i)
             if (st->inflight[i] && !st->lost) (void)rc__vk_wait(st, i);
     return s;
+}
+
+rc_status rc__vk_device_results(rc_context *ctx, rc_device_results *out)
+{
+    rc__vk_state *st = rc__vk(ctx);
+    RC_RETURN_IF(ctx, st->lost, RC_ERR_DEVICE_LOST, "vulkan: the device was lost; destroy the context");
+    RC_RETURN_IF(ctx, st->dev_res.struct_size == 0, RC_ERR_INVALID_ARGUMENT,
+                 "no results are on the device: the last rc_simulate on this context did not set "
+                 "RC_RESULTS_ON_DEVICE in results->flags (or failed)");
+    *out = st->dev_res;
+    return RC_OK;
 }
