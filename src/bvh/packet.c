@@ -11,6 +11,7 @@
 #include "bvh/packet.h"
 
 #include "bvh/intersect.h"
+#include "bvh/leaf4.h"
 
 #include <float.h>
 
@@ -290,20 +291,28 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                 continue;
             }
         } else {
-            const uint32_t end = child + count;
-            uint32_t j;
-            for (j = child; j < end; ++j) {
-                const uint32_t *tri = leaf_tris + (size_t)3 * j;
-                const float *a = vertices + tri[0] * stride, *b = vertices + tri[1] * stride;
-                const float *c = vertices + tri[2] * stride;
-                uint32_t m = mask;
-                while (m) {
-                    uint32_t lane = 0;
+            /* lane by lane: the leaf's four triangles through the SIMD
+             * filter, then the watertight test on what is left */
+            const float *vt[4][3];
+            uint32_t q, m = mask, n_tri = count < 4u ? count : 4u;
+            for (q = 0; q < n_tri; ++q) {
+                const uint32_t *tri = leaf_tris + (size_t)3 * (child + q);
+                vt[q][0] = vertices + tri[0] * stride;
+                vt[q][1] = vertices + tri[1] * stride;
+                vt[q][2] = vertices + tri[2] * stride;
+            }
+            while (m) {
+                uint32_t lane = 0, cand;
+                while (!((m >> lane) & 1u)) ++lane;
+                m &= m - 1u;
+                cand = rc__leaf4_candidates(&rays[lane], (const float *const(*)[3])vt, n_tri);
+                while (cand) {
+                    uint32_t c = 0;
                     float t, u, v;
-                    while (!((m >> lane) & 1u)) ++lane;
-                    m &= m - 1u;
-                    if (!rc__tri_intersect(&rays[lane], a, b, c, &t, &u, &v)) continue;
-                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[j], j, geom, inst)) continue;
+                    while (!((cand >> c) & 1u)) ++c;
+                    cand &= cand - 1u;
+                    if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
+                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[child + c], child + c, geom, inst)) continue;
                     L.tmax[lane] = t;
                     found[lane] = 1;
                 }
