@@ -5,14 +5,12 @@
 #define RC__WIDE_FORCE_SCALAR 1
 #define RC__PACKET_FORCE_SCALAR 1
 #define rc__mesh_intersect_wide scalar_intersect_wide
-#define rc__mesh_intersect_wide_from scalar_intersect_wide_from
 #define rc__mesh_occluded_wide scalar_occluded_wide
 #include "../src/bvh/wide_trace.c"
 #define rc__mesh_intersect_packet scalar_intersect_packet
 #include "../src/bvh/packet.c"
 #undef rc__mesh_intersect_packet
 #undef rc__mesh_intersect_wide
-#undef rc__mesh_intersect_wide_from
 #undef rc__mesh_occluded_wide
 
 #include <math.h>

@@ -68,10 +68,6 @@ int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, 
 int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                             rc__hit *hit);
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
-/* Nearest-hit search of the subtree under wide node `node` only (the packet
- * traversal hands a lane over when its packet has thinned out). */
-int rc__mesh_intersect_wide_from(const rc__mesh *mesh, uint32_t node, const rc__ray *ray, uint32_t geom,
-                                 uint32_t inst, rc__hit *hit);
 
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);

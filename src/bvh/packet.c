@@ -33,10 +33,6 @@ typedef struct packet_entry {
     float tmin;     /* smallest entry distance of those lanes (ordering only) */
 } packet_entry;
 
-/* A node reached by at most this many lanes is finished ray by ray: below
- * that, the packet's shared fetch no longer pays for its 16-lane tests. */
-#define SINGLE_BELOW 2u
-
 /* Per-lane slab data, 16-byte aligned rows of 4 lanes. */
 typedef struct packet_lanes {
     float ix[LANES], iy[LANES], iz[LANES];
@@ -69,6 +65,7 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
     __m128 best = _mm_set1_ps(FLT_MAX);
     for (g = 0; g < GROUPS; ++g) {
+        if (!((mask >> (4u * g)) & 0xFu)) continue; /* no live lane in these four */
         const __m128 ix = _mm_load_ps(L->ix + 4 * g), iy = _mm_load_ps(L->iy + 4 * g);
         const __m128 iz = _mm_load_ps(L->iz + 4 * g);
         /* max/min return their second operand when the first is NaN: a NaN
@@ -100,6 +97,7 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
     const uint32x4_t vbits = vld1q_u32(bits);
     for (g = 0; g < GROUPS; ++g) {
+        if (!((mask >> (4u * g)) & 0xFu)) continue; /* no live lane in these four */
         const float32x4_t ix = vld1q_f32(L->ix + 4 * g), iy = vld1q_f32(L->iy + 4 * g);
         const float32x4_t iz = vld1q_f32(L->iz + 4 * g);
         float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(L->tmax + 4 * g), a;
@@ -208,13 +206,6 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
     }
 }
 
-static uint32_t popcount16(uint32_t m)
-{
-    uint32_t n = 0;
-    for (; m; m &= m - 1u) ++n;
-    return n;
-}
-
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
                                uint32_t inst, rc__hit *hits, int *found)
 {
@@ -248,20 +239,7 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
     }
     mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     for (;;) {
-        if (count == 0 && popcount16(mask) <= SINGLE_BELOW) {
-            /* thinned out: the lanes left finish this subtree alone */
-            uint32_t m = mask;
-            while (m) {
-                uint32_t lane = 0;
-                while (!((m >> lane) & 1u)) ++lane;
-                m &= m - 1u;
-                hits[lane].t = L.tmax[lane];
-                if (rc__mesh_intersect_wide_from(mesh, child, &rays[lane], geom, inst, &hits[lane])) {
-                    L.tmax[lane] = hits[lane].t;
-                    found[lane] = 1;
-                }
-            }
-        } else if (count == 0) {
+        if (count == 0) {
             const rc__wnode *nd = &nodes[child];
             packet_entry e[4];
             uint32_t m = 0, c, j;

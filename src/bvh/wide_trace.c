@@ -136,8 +136,8 @@ static RC__WALWAYS uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w,
 #endif
 }
 
-static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, uint32_t start, const rc__ray *ray, uint32_t geom,
-                                     uint32_t inst, rc__hit *hit, float tmax, int any_hit)
+static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
+                                     rc__hit *hit, float tmax, int any_hit)
 {
     const rc__wnode *nodes = mesh->wide;
     const uint32_t *refs = mesh->bvh.refs;
@@ -147,7 +147,7 @@ static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, uint32_t start, const
     const rc__ray r = *ray;
     wide_ray w;
     wide_entry stack[STACK_SIZE];
-    uint32_t sp = 0, child = start, count = 0;
+    uint32_t sp = 0, child = 0, count = 0;
     float tcur = tmax;
     int found = 0;
 
@@ -242,16 +242,10 @@ static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, uint32_t start, const
 
 int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst, rc__hit *hit)
 {
-    return wide_traverse(mesh, 0, ray, geom, inst, hit, hit->t, 0);
-}
-
-int rc__mesh_intersect_wide_from(const rc__mesh *mesh, uint32_t node, const rc__ray *ray, uint32_t geom,
-                                 uint32_t inst, rc__hit *hit)
-{
-    return wide_traverse(mesh, node, ray, geom, inst, hit, hit->t, 0);
+    return wide_traverse(mesh, ray, geom, inst, hit, hit->t, 0);
 }
 
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax)
 {
-    return wide_traverse(mesh, 0, ray, 0, 0, NULL, tmax, 1);
+    return wide_traverse(mesh, ray, 0, 0, NULL, tmax, 1);
 }
