@@ -55,9 +55,19 @@ asan sanitize:
 
 ubsan: asan
 
+# Every cmocka runner under valgrind (quick sizes; the Vulkan backend is left
+# out, runners and shared suites alike: lavapipe's and LLVM's own memory and
+# glibc's dlopen of the driver are not ours to judge). ctest -T memcheck
+# would need CTest's dashboard files, so the runners are called directly.
 valgrind: build
-	cd $(BUILD) && RC_TEST_QUICK=1 ctest --output-on-failure -E vulkan -T memcheck \
-		--overwrite MemoryCheckCommandOptions="--leak-check=full --error-exitcode=1"
+	@command -v valgrind >/dev/null || { echo "valgrind: apt-get install -y valgrind"; exit 1; }
+	cd $(BUILD)/tests && for t in test_*; do \
+		case $$t in *vulkan*) continue ;; esac; [ -f $$t ] && [ -x $$t ] || continue; \
+		echo "valgrind $$t"; \
+		RC_TEST_QUICK=1 RC_TEST_SKIP_BACKENDS=vulkan valgrind -q --leak-check=full --errors-for-leak-kinds=definite,indirect \
+			--suppressions=$(CURDIR)/tests/valgrind.supp \
+			--error-exitcode=1 ./$$t >/dev/null || { echo "valgrind: $$t failed"; exit 1; }; \
+	done; echo "valgrind: no errors, no leaks"
 
 bench: build
 	./$(BUILD)/tools/rangecast bench --sensor vlp16 --backend bvh --threads 2 --repeat 3

@@ -152,6 +152,87 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     return out & mask;
 }
 
+/* The packet as a whole: per axis the smallest and largest reciprocal
+ * direction over its rays (one octant, so one sign per axis). */
+typedef struct packet_bounds {
+    float ilo[3], ihi[3];
+    float tmax;  /* largest tmax over the lanes */
+    int usable;  /* 0 when a reciprocal is infinite (a zero direction component) */
+} packet_bounds;
+
+/* Children of n that some ray of the packet may meet: an interval version
+ * of box_mask over all four children at once. For a fixed plane offset
+ * (plane - origin) the product with the reciprocal is monotonic in the
+ * reciprocal, rounding included, so the two products with the packet's
+ * smallest and largest reciprocals bound every lane's product exactly as
+ * box_mask computes it: a child rejected here is rejected by every lane
+ * there. Children of no lane are then skipped without their 16-lane tests. */
+static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes *L, const packet_bounds *P)
+{
+#if defined(RC__PACKET_SSE2)
+    __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(P->tmax);
+    uint32_t k;
+    for (k = 0; k < 3; ++k) {
+        const __m128 o = _mm_set1_ps(L->org[k]), lo = _mm_set1_ps(P->ilo[k]), hi = _mm_set1_ps(P->ihi[k]);
+        const __m128 pn = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k]]), o);
+        const __m128 pf = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k] ^ 1u]), o);
+        t0 = _mm_max_ps(_mm_min_ps(_mm_mul_ps(pn, lo), _mm_mul_ps(pn, hi)), t0);
+        t1 = _mm_min_ps(_mm_max_ps(_mm_mul_ps(pf, lo), _mm_mul_ps(pf, hi)), t1);
+    }
+    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
+#elif defined(RC__PACKET_NEON)
+    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
+    float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(P->tmax);
+    uint32_t k;
+    uint32x4_t h;
+    uint32x2_t s2;
+    for (k = 0; k < 3; ++k) {
+        const float32x4_t o = vdupq_n_f32(L->org[k]), lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
+        const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), o);
+        const float32x4_t pf = vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), o);
+        t0 = vmaxq_f32(vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi)), t0);
+        t1 = vminq_f32(vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi)), t1);
+    }
+    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
+    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
+    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+#else
+    uint32_t c, k, out = 0;
+    for (c = 0; c < 4; ++c) {
+        float t0 = 0.0f, t1 = P->tmax;
+        for (k = 0; k < 3; ++k) {
+            const float pn = n->box[L->near_row[k]][c] - L->org[k], pf = n->box[L->near_row[k] ^ 1u][c] - L->org[k];
+            const float a = pn * P->ilo[k], b = pn * P->ihi[k], d = pf * P->ilo[k], e = pf * P->ihi[k];
+            const float lo = a < b ? a : b, hi = d > e ? d : e;
+            t0 = lo > t0 ? lo : t0;
+            t1 = hi < t1 ? hi : t1;
+        }
+        if (t0 <= t1 * RC__SLAB_FAR_SCALE) out |= 1u << c;
+    }
+    return out;
+#endif
+}
+
+static void packet_bounds_init(packet_bounds *P, const packet_lanes *L, uint32_t n)
+{
+    const float *inv[3] = {L->ix, L->iy, L->iz};
+    uint32_t i, k;
+    P->usable = 1;
+    P->tmax = L->tmax[0];
+    for (i = 1; i < n; ++i) P->tmax = L->tmax[i] > P->tmax ? L->tmax[i] : P->tmax;
+    for (k = 0; k < 3; ++k) {
+        P->ilo[k] = P->ihi[k] = inv[k][0];
+        for (i = 0; i < n; ++i) {
+            const float v = inv[k][i];
+            if (!(v > -FLT_MAX && v < FLT_MAX)) P->usable = 0; /* inf: the NaN cases of box_mask */
+            P->ilo[k] = v < P->ilo[k] ? v : P->ilo[k];
+            P->ihi[k] = v > P->ihi[k] ? v : P->ihi[k];
+        }
+    }
+    /* tmax beyond float range would make inf * 0 possible below */
+    if (!(P->tmax < FLT_MAX)) P->usable = 0;
+}
+
 /* 1 when every ray of the packet has the same direction signs (by the sign of
  * its reciprocal, so -0 counts as negative, as in the single-ray test). */
 static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_row[3])
@@ -215,6 +296,7 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
     const float *vertices = mesh->vertices;
     const size_t stride = mesh->stride;
     packet_lanes L RC__ALIGN16;
+    packet_bounds P;
     /* up to three pushes per level */
     packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
     uint32_t sp = 0, i, child = 0, count = 0, mask;
@@ -238,15 +320,16 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
         L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
     }
     mask = (n >= 32u ? 0u : (1u << n)) - 1u;
+    packet_bounds_init(&P, &L, n);
     for (;;) {
         if (count == 0) {
             const rc__wnode *nd = &nodes[child];
             packet_entry e[4];
-            uint32_t m = 0, c, j;
+            uint32_t m = 0, c, j, maybe = P.usable ? children_maybe_hit(nd, &L, &P) : 0xFu;
             for (c = 0; c < 4; ++c) {
                 float t;
                 uint32_t mc;
-                if (nd->child[c] == RC__WIDE_EMPTY) continue;
+                if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
                 mc = box_mask(nd, c, &L, mask, &t);
                 if (!mc) continue;
                 e[m].child = nd->child[c];
@@ -294,6 +377,11 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                     L.tmax[lane] = t;
                     found[lane] = 1;
                 }
+            }
+            if (P.usable) { /* hits only shrink tmax: tighten the packet's bound */
+                uint32_t q2;
+                P.tmax = L.tmax[0];
+                for (q2 = 1; q2 < n; ++q2) P.tmax = L.tmax[q2] > P.tmax ? L.tmax[q2] : P.tmax;
             }
         }
         /* pop; lanes that have since found nearer hits drop out in the box

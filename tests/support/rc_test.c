@@ -19,8 +19,13 @@ int rct_backend_usable(uint32_t backend)
     rc_context_desc d = rc_context_desc_default();
     rc_context *ctx = NULL;
     rc_status st;
+    const char *skip = getenv("RC_TEST_SKIP_BACKENDS"); /* e.g. "vulkan" under valgrind */
     if (!rc_backend_available(backend)) {
         print_message("SKIP: backend %s is not built in\n", rc_backend_name(backend));
+        return 0;
+    }
+    if (skip && strstr(skip, rc_backend_name(backend))) {
+        print_message("SKIP: backend %s is in RC_TEST_SKIP_BACKENDS\n", rc_backend_name(backend));
         return 0;
     }
     d.backend = backend;
