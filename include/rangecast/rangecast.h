@@ -278,6 +278,10 @@ RC_API rc_scene_desc rc_scene_desc_default(void);
  * scene is committed, one byte less fails with RC_ERR_OUT_OF_MEMORY. With
  * several scenes the sum is an upper bound (their scratch is not live at the
  * same time). Holds on a fresh context (no holes left by destroyed objects).
+ * The built-in backend reserves its tree's worst case at commit and gives the
+ * unused part back afterwards (rc_scene_info.bytes is what it keeps); a commit
+ * after rc_scene_add_mesh rebuilds every mesh and needs the whole reservation
+ * again, so leave that room free (rc_scene_update_mesh only refits, in place).
  * Embree and Vulkan also allocate outside the arena (rc_memory_stats). */
 RC_API rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_desc *desc,
                                               size_t *bytes);
