@@ -283,6 +283,68 @@ static void test_refit(void **state)
     rcu_mesh_free(&m);
 }
 
+/* A mesh added after the first commit: the trimmed block is released and
+ * every mesh rebuilt; both meshes answer (each against its own binary tree),
+ * the block kept is what the trees use, and the same arena can do it again. */
+static void test_add_mesh_after_commit(void **state)
+{
+    rcu_mesh a, b;
+    const float lo[3] = {-3.0f, -2.0f, -1.0f}, hi[3] = {2.0f, 4.0f, 1.5f};
+    rc_context *ctx;
+    rc_scene *scene;
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    rc_scene_info i1 = rc_scene_info_default(), i2 = rc_scene_info_default();
+    binary_mesh ba, bb;
+    uint32_t g, round;
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 120, 60, &a), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &b), 0);
+    ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    sd.max_geometries = 2;
+    sd.max_triangles = a.triangle_count + b.triangle_count;
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    md.vertices = a.vertices;
+    md.vertex_count = a.vertex_count;
+    md.indices = a.indices;
+    md.triangle_count = a.triangle_count;
+    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+    RCT_OK(ctx, rc_scene_commit(scene));
+    RCT_OK(ctx, rc_scene_get_info(scene, &i1));
+    md.vertices = b.vertices;
+    md.vertex_count = b.vertex_count;
+    md.indices = b.indices;
+    md.triangle_count = b.triangle_count;
+    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &g));
+    for (round = 0; round < 2; ++round) {
+        uint32_t k;
+        RCT_OK(ctx, rc_scene_commit(scene));
+        check_structure(&scene->geoms[0].mesh);
+        check_structure(&scene->geoms[1].mesh);
+        binary_of(&scene->geoms[0].mesh, &ba);
+        binary_of(&scene->geoms[1].mesh, &bb);
+        for (k = 0; k < 500; ++k) {
+            float org[3] = {0.0f, 0.0f, 0.0f}, dir[3];
+            double y = uniform() * 6.283185307, p = (uniform() - 0.5) * 3.0;
+            dir[0] = (float)(cos(p) * cos(y));
+            dir[1] = (float)(cos(p) * sin(y));
+            dir[2] = (float)sin(p);
+            compare_ray(&scene->geoms[0].mesh, &ba.mesh, org, dir);
+            compare_ray(&scene->geoms[1].mesh, &bb.mesh, org, dir);
+        }
+        binary_free(&ba);
+        binary_free(&bb);
+        RCT_OK(ctx, rc_scene_get_info(scene, &i2));
+        assert_true(i2.bytes > i1.bytes); /* the box's tree and refs were added */
+        /* the scene is full (2 geometries): refused, and the next round's
+         * commit of the unchanged scene keeps the trees as they are */
+        assert_int_not_equal(rc_scene_add_mesh(scene, &md, &g), RC_OK);
+    }
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&a);
+    rcu_mesh_free(&b);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -290,6 +352,7 @@ int main(void)
         cmocka_unit_test(test_small_meshes),
         cmocka_unit_test(test_wide_equals_binary),
         cmocka_unit_test(test_refit),
+        cmocka_unit_test(test_add_mesh_after_commit),
     };
     return cmocka_run_group_tests_name("wide BVH", tests, NULL, NULL);
 }
