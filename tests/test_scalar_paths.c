@@ -16,6 +16,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "poses.h"
 #include "rc_test.h"
 #include "scene/scene.h"
 
@@ -24,14 +25,9 @@ int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax)
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
                                rc__hit *hits, int *found);
 
-static uint64_t rng = 0x2545F4914F6CDD1Dull;
-static double uniform(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
-}
+/* the tools' generator, seeded in main */
+static rcu_rng rng;
+static double uniform(void) { return rcu_rng_uniform(&rng); }
 
 static void hit_init(rc__hit *h)
 {
@@ -116,6 +112,7 @@ static void test_scalar_equals_simd(void **state)
 
 int main(void)
 {
+    rcu_rng_seed(&rng, 0x2545F4914F6CDD1Dull);
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_scalar_equals_simd)};
     return cmocka_run_group_tests_name("scalar box tests", tests, NULL, NULL);
 }

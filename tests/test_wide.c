@@ -10,17 +10,13 @@
 #include <string.h>
 
 #include "bvh/intersect.h"
+#include "poses.h"
 #include "rc_test.h"
 #include "scene/scene.h"
 
-static uint64_t rng = 0x9E3779B97F4A7C15ull;
-static double uniform(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(rng >> 11) / 9007199254740992.0;
-}
+/* the tools' generator, seeded in main */
+static rcu_rng rng;
+static double uniform(void) { return rcu_rng_uniform(&rng); }
 
 /* The scene's mesh again with its binary tree (built here) instead of the
  * wide one, so both traversals see the same triangles and leaf order. */
@@ -347,6 +343,7 @@ static void test_add_mesh_after_commit(void **state)
 
 int main(void)
 {
+    rcu_rng_seed(&rng, 0x9E3779B97F4A7C15ull);
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_collapse_structure),
         cmocka_unit_test(test_small_meshes),

@@ -214,16 +214,8 @@ static int packed_mesh(const rc__vk_packed *p, uint32_t gi, uint32_t geom_id, ui
                 if (!rc__tri_intersect(ray, p->verts + (size_t)3u * tri[0], p->verts + (size_t)3u * tri[1],
                                        p->verts + (size_t)3u * tri[2], &t, &u, &v))
                     continue;
-                if (t > hit->t) continue;
-                if (t == hit->t && !rc__hit_key_less(inst, geom_id, prim, hit)) continue;
-                hit->t = t;
-                hit->u = u;
-                hit->v = v;
-                hit->prim = prim;
-                hit->slot = RC_INVALID_ID;
-                hit->geom = geom_id;
-                hit->inst = inst;
-                found = 1;
+                /* slot unknown: the packed arrays have their own order */
+                if (rc__hit_offer(hit, t, u, v, prim, RC_INVALID_ID, geom_id, inst)) found = 1;
             }
         }
         for (;;) {

@@ -103,9 +103,11 @@ static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, flo
 #if defined(__GNUC__)
 #define RC__COLD static __attribute__((noinline, unused))
 #define RC__FORCE_INLINE inline __attribute__((always_inline))
+#define RC__ALIGN16 __attribute__((aligned(16)))
 #else
 #define RC__COLD static inline
 #define RC__FORCE_INLINE inline
+#define RC__ALIGN16
 #endif
 
 /* double to float without overflow (huge coordinates). */

@@ -21,6 +21,23 @@
 #define RC__LEAF4_NEON 1
 #endif
 
+/* The vertices of leaf slots first .. first + count (count <= 4; more is
+ * clamped: the builder never makes more) from a mesh's leaf-ordered index
+ * triples (the caller's hoisted copies of its fields). Returns the count used. */
+static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, const float *vertices, size_t stride,
+                                                   uint32_t first, uint32_t count, const float *v[4][3])
+{
+    uint32_t i;
+    if (count > 4u) count = 4u;
+    for (i = 0; i < count; ++i) {
+        const uint32_t *tri = leaf_tris + (size_t)3 * (first + i);
+        v[i][0] = vertices + tri[0] * stride;
+        v[i][1] = vertices + tri[1] * stride;
+        v[i][2] = vertices + tri[2] * stride;
+    }
+    return count;
+}
+
 /* Bit i set for triangle i (< count) that rc__tri_intersect must still test;
  * v[i][0..2] are its vertices (slots >= count are ignored). */
 static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const float *const v[4][3], uint32_t count)

@@ -79,10 +79,8 @@ void rc__mesh_triangle_normal(const rc__mesh *mesh, uint32_t prim, float n[3])
 }
 
 #if defined(__GNUC__)
-#define RC__ALWAYS_INLINE inline __attribute__((always_inline))
 #define RC__NOINLINE __attribute__((noinline))
 #else
-#define RC__ALWAYS_INLINE inline
 #define RC__NOINLINE
 #endif
 
@@ -106,7 +104,7 @@ static RC__NOINLINE void rc__slab_init_opaque(rc__slab_ray *s, const rc__ray *ra
  * carries the (index, count) fields of the node to visit, read when its box
  * was tested (software prefetching one level ahead measured 3-6% slower).
  * With any_hit, returns at the first hit with t < tmax. */
-static RC__ALWAYS_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom,
+static RC__FORCE_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom,
                                           uint32_t inst, rc__hit *hit, float tmax, int any_hit)
 {
     const rc__bvh_node *nodes = mesh->bvh.nodes;

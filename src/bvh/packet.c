@@ -41,11 +41,6 @@ typedef struct packet_lanes {
     float org[3];
 } packet_lanes;
 
-#if defined(__GNUC__)
-#define RC__ALIGN16 __attribute__((aligned(16)))
-#else
-#define RC__ALIGN16
-#endif
 
 /* Lanes of `mask` whose ray meets the box within [0, tmax]; *tmin_out gets a
  * lower bound of their entry distances (for ordering only). */
@@ -355,13 +350,8 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
             /* lane by lane: the leaf's four triangles through the SIMD
              * filter, then the watertight test on what is left */
             const float *vt[4][3];
-            uint32_t q, m = mask, n_tri = count < 4u ? count : 4u;
-            for (q = 0; q < n_tri; ++q) {
-                const uint32_t *tri = leaf_tris + (size_t)3 * (child + q);
-                vt[q][0] = vertices + tri[0] * stride;
-                vt[q][1] = vertices + tri[1] * stride;
-                vt[q][2] = vertices + tri[2] * stride;
-            }
+            const uint32_t n_tri = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
+            uint32_t m = mask;
             while (m) {
                 uint32_t lane = 0, cand;
                 while (!((m >> lane) & 1u)) ++lane;

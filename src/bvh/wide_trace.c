@@ -22,13 +22,6 @@
 #define RC__WIDE_NEON 1
 #endif
 
-#if defined(__GNUC__)
-#define RC__WALWAYS inline __attribute__((always_inline))
-#define RC__WALIGN16 __attribute__((aligned(16)))
-#else
-#define RC__WALWAYS inline
-#define RC__WALIGN16
-#endif
 
 /* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
 #define STACK_SIZE (3u * RC__BVH_MAX_DEPTH + 4u)
@@ -63,7 +56,7 @@ static void wide_ray_init(wide_ray *w, const rc__ray *r)
 /* Index of the lowest set bit (mask != 0). A loop on purpose: masks are
  * mostly 1 and the loop's branch predicts well; __builtin_ctz measured 10%
  * slower over the whole traversal (gcc 12, x86-64). */
-static RC__WALWAYS uint32_t lowest_bit(uint32_t mask)
+static RC__FORCE_INLINE uint32_t lowest_bit(uint32_t mask)
 {
     uint32_t c = 0;
     while (!((mask >> c) & 1u)) ++c;
@@ -72,7 +65,7 @@ static RC__WALWAYS uint32_t lowest_bit(uint32_t mask)
 
 /* Bit c set when the ray meets child c's box within [0, tmax]
  * (conservatively, Ize's bound); tn[c] gets the entry distance. */
-static RC__WALWAYS uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w, float tmax, float tn[4])
+static RC__FORCE_INLINE uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w, float tmax, float tn[4])
 {
     const float *nx = n->box[w->near_row[0]], *fx = n->box[w->near_row[0] ^ 1u];
     const float *ny = n->box[w->near_row[1]], *fy = n->box[w->near_row[1] ^ 1u];
@@ -136,7 +129,7 @@ static RC__WALWAYS uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w,
 #endif
 }
 
-static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
+static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                                      rc__hit *hit, float tmax, int any_hit)
 {
     const rc__wnode *nodes = mesh->wide;
@@ -156,7 +149,7 @@ static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, u
     for (;;) {
         if (count == 0) {
             const rc__wnode *n = &nodes[child];
-            float tn[4] RC__WALIGN16;
+            float tn[4] RC__ALIGN16;
             uint32_t mask = wide_box_test(n, &w, tcur, tn);
             if (mask == 0) goto pop;
             {
@@ -201,14 +194,8 @@ static RC__WALWAYS int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, u
             }
         } else {
             const float *vt[4][3];
-            uint32_t i, cand;
-            if (count > 4u) count = 4u; /* the builder never makes more; a corrupt tree loses triangles */
-            for (i = 0; i < count; ++i) {
-                const uint32_t *tri = leaf_tris + (size_t)3 * (child + i);
-                vt[i][0] = vertices + tri[0] * stride;
-                vt[i][1] = vertices + tri[1] * stride;
-                vt[i][2] = vertices + tri[2] * stride;
-            }
+            uint32_t cand;
+            count = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
             cand = rc__leaf4_candidates(&r, (const float *const(*)[3])vt, count);
             while (cand) {
                 const uint32_t j = child + lowest_bit(cand);
