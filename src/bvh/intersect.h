@@ -225,10 +225,9 @@ static inline int rc__hit_key_less(uint32_t inst, uint32_t geom, uint32_t prim, 
 
 /* Records (t, u, v) on triangle prim as the nearest hit when it beats *h:
  * nearer, or as near with a smaller key. Returns 1 when it did. */
-static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot, uint32_t geom,
-                                uint32_t inst)
+static inline void rc__hit_record(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot,
+                                  uint32_t geom, uint32_t inst)
 {
-    if (t > h->t || (t == h->t && !rc__hit_key_less(inst, geom, prim, h))) return 0;
     h->t = t;
     h->u = u;
     h->v = v;
@@ -236,7 +235,40 @@ static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t 
     h->slot = slot;
     h->geom = geom;
     h->inst = inst;
+}
+
+static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot, uint32_t geom,
+                                uint32_t inst)
+{
+    if (t > h->t || (t == h->t && !rc__hit_key_less(inst, geom, prim, h))) return 0;
+    rc__hit_record(h, t, u, v, prim, slot, geom, inst);
     return 1;
+}
+
+/* Prim id of a hit recorded by rc__hit_offer_slot and not yet settled. */
+#define RC__PRIM_PENDING 0xFFFFFFFEu
+
+/* rc__hit_offer for triangle refs[slot] of the mesh being traversed, without
+ * reading refs[slot] unless there is a tie: the hit keeps only its slot and a
+ * pending prim until rc__hit_settle. The references are a separate array from
+ * the leaf data, and reading one per candidate hit measured as a cache miss
+ * on large maps; one read per ray at the end is off the traversal's path. */
+static inline int rc__hit_offer_slot(rc__hit *h, float t, float u, float v, const uint32_t *refs, uint32_t slot,
+                                     uint32_t geom, uint32_t inst)
+{
+    if (t > h->t) return 0;
+    if (t == h->t) {
+        if (h->prim == RC__PRIM_PENDING) h->prim = refs[h->slot];
+        if (!rc__hit_key_less(inst, geom, refs[slot], h)) return 0;
+    }
+    rc__hit_record(h, t, u, v, RC__PRIM_PENDING, slot, geom, inst);
+    return 1;
+}
+
+/* Resolves the pending prim id of a hit from rc__hit_offer_slot. */
+static inline void rc__hit_settle(rc__hit *h, const uint32_t *refs)
+{
+    if (h->prim == RC__PRIM_PENDING) h->prim = refs[h->slot];
 }
 
 #endif

@@ -30,7 +30,7 @@ typedef struct packet_entry {
     uint32_t child;
     uint32_t count; /* 0: a node; else a leaf's triangle count */
     uint32_t mask;  /* lanes that met its box when it was pushed */
-    float tmin;     /* smallest entry distance of those lanes (ordering only) */
+    float tmin;     /* the packet's entry bound (ordering only) */
 } packet_entry;
 
 /* Per-lane slab data, 16-byte aligned rows of 4 lanes. */
@@ -42,10 +42,8 @@ typedef struct packet_lanes {
 } packet_lanes;
 
 
-/* Lanes of `mask` whose ray meets the box within [0, tmax]; *tmin_out gets a
- * lower bound of their entry distances (for ordering only). */
-static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask,
-                                float *tmin_out)
+/* Lanes of `mask` whose ray meets the box within [0, tmax]. */
+static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask)
 {
     const float nx = n->box[L->near_row[0]][c] - L->org[0];
     const float ny = n->box[L->near_row[1]][c] - L->org[1];
@@ -58,7 +56,6 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     const __m128 vnx = _mm_set1_ps(nx), vny = _mm_set1_ps(ny), vnz = _mm_set1_ps(nz);
     const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy), vfz = _mm_set1_ps(fz);
     const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
-    __m128 best = _mm_set1_ps(FLT_MAX);
     for (g = 0; g < GROUPS; ++g) {
         if (!((mask >> (4u * g)) & 0xFu)) continue; /* no live lane in these four */
         const __m128 ix = _mm_load_ps(L->ix + 4 * g), iy = _mm_load_ps(L->iy + 4 * g);
@@ -71,24 +68,12 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
         t0 = _mm_max_ps(_mm_mul_ps(vnz, iz), t0);
         t1 = _mm_min_ps(_mm_mul_ps(vfy, iy), t1);
         t1 = _mm_min_ps(_mm_mul_ps(vfz, iz), t1);
-        {
-            const __m128 h = _mm_cmple_ps(t0, _mm_mul_ps(t1, scale));
-            out |= (uint32_t)_mm_movemask_ps(h) << (4 * g);
-            best = _mm_min_ps(best, _mm_or_ps(_mm_and_ps(h, t0), _mm_andnot_ps(h, _mm_set1_ps(FLT_MAX))));
-        }
-    }
-    {
-        float b[4] RC__ALIGN16;
-        _mm_store_ps(b, best);
-        b[0] = b[0] < b[1] ? b[0] : b[1];
-        b[2] = b[2] < b[3] ? b[2] : b[3];
-        *tmin_out = b[0] < b[2] ? b[0] : b[2];
+        out |= (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, scale))) << (4 * g);
     }
 #elif defined(RC__PACKET_NEON)
     const float32x4_t vnx = vdupq_n_f32(nx), vny = vdupq_n_f32(ny), vnz = vdupq_n_f32(nz);
     const float32x4_t vfx = vdupq_n_f32(fx), vfy = vdupq_n_f32(fy), vfz = vdupq_n_f32(fz);
-    const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE), big = vdupq_n_f32(FLT_MAX);
-    float32x4_t best = big;
+    const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE);
     static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
     const uint32x4_t vbits = vld1q_u32(bits);
     for (g = 0; g < GROUPS; ++g) {
@@ -116,16 +101,9 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
             uint32x2_t s2 = vorr_u32(vget_low_u32(m), vget_high_u32(m));
             out |= (vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1)) << (4 * g);
         }
-        best = vminq_f32(best, vbslq_f32(h, t0, big));
-    }
-    {
-        float32x2_t m2 = vmin_f32(vget_low_f32(best), vget_high_f32(best));
-        float a0 = vget_lane_f32(m2, 0), a1 = vget_lane_f32(m2, 1);
-        *tmin_out = a0 < a1 ? a0 : a1;
     }
 #else
     {
-        float best = FLT_MAX;
         for (g = 0; g < LANES; ++g) {
             const float ax = nx * L->ix[g], ay = ny * L->iy[g], az = nz * L->iz[g];
             const float bx = fx * L->ix[g], by = fy * L->iy[g], bz = fz * L->iz[g];
@@ -136,12 +114,8 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
             t1 = bx < t1 ? bx : t1;
             t1 = by < t1 ? by : t1;
             t1 = bz < t1 ? bz : t1;
-            if (t0 <= t1 * RC__SLAB_FAR_SCALE) {
-                out |= 1u << g;
-                if (t0 < best) best = t0;
-            }
+            if (t0 <= t1 * RC__SLAB_FAR_SCALE) out |= 1u << g;
         }
-        *tmin_out = best;
     }
 #endif
     return out & mask;
@@ -161,8 +135,11 @@ typedef struct packet_bounds {
  * reciprocal, rounding included, so the two products with the packet's
  * smallest and largest reciprocals bound every lane's product exactly as
  * box_mask computes it: a child rejected here is rejected by every lane
- * there. Children of no lane are then skipped without their 16-lane tests. */
-static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes *L, const packet_bounds *P)
+ * there. Children of no lane are then skipped without their 16-lane tests.
+ * tn[c] gets child c's entry bound for the whole packet: the order in which
+ * met children are visited (it only orders work; it never culls). */
+static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes *L, const packet_bounds *P,
+                                          float tn[4])
 {
 #if defined(RC__PACKET_SSE2)
     __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(P->tmax);
@@ -174,6 +151,7 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
         t0 = _mm_max_ps(_mm_min_ps(_mm_mul_ps(pn, lo), _mm_mul_ps(pn, hi)), t0);
         t1 = _mm_min_ps(_mm_max_ps(_mm_mul_ps(pf, lo), _mm_mul_ps(pf, hi)), t1);
     }
+    _mm_store_ps(tn, t0);
     return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
 #elif defined(RC__PACKET_NEON)
     static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
@@ -188,6 +166,7 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
         t0 = vmaxq_f32(vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi)), t0);
         t1 = vminq_f32(vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi)), t1);
     }
+    vst1q_f32(tn, t0);
     h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
     s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
     return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
@@ -202,6 +181,7 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
             t0 = lo > t0 ? lo : t0;
             t1 = hi < t1 ? hi : t1;
         }
+        tn[c] = t0;
         if (t0 <= t1 * RC__SLAB_FAR_SCALE) out |= 1u << c;
     }
     return out;
@@ -320,17 +300,17 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
         if (count == 0) {
             const rc__wnode *nd = &nodes[child];
             packet_entry e[4];
-            uint32_t m = 0, c, j, maybe = P.usable ? children_maybe_hit(nd, &L, &P) : 0xFu;
+            float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
+            uint32_t m = 0, c, j, maybe = P.usable ? children_maybe_hit(nd, &L, &P, tn) : 0xFu;
             for (c = 0; c < 4; ++c) {
-                float t;
                 uint32_t mc;
                 if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
-                mc = box_mask(nd, c, &L, mask, &t);
+                mc = box_mask(nd, c, &L, mask);
                 if (!mc) continue;
                 e[m].child = nd->child[c];
                 e[m].count = nd->count[c];
                 e[m].mask = mc;
-                e[m].tmin = t;
+                e[m].tmin = tn[c];
                 /* keep e sorted by the packet's smallest entry distance */
                 for (j = m; j > 0 && e[j].tmin < e[j - 1].tmin; --j) {
                     const packet_entry tmp = e[j];
@@ -351,11 +331,14 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
              * filter, then the watertight test on what is left */
             const float *vt[4][3];
             const uint32_t n_tri = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
-            uint32_t m = mask;
-            while (m) {
-                uint32_t lane = 0, cand;
-                while (!((m >> lane) & 1u)) ++lane;
-                m &= m - 1u;
+            uint32_t m = mask, lane = 0;
+            int shrunk = 0;
+            for (; m; ++lane, m >>= 1) {
+                uint32_t cand;
+                while (!(m & 1u)) {
+                    ++lane;
+                    m >>= 1;
+                }
                 cand = rc__leaf4_candidates(&rays[lane], (const float *const(*)[3])vt, n_tri);
                 while (cand) {
                     uint32_t c = 0;
@@ -363,12 +346,13 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                     while (!((cand >> c) & 1u)) ++c;
                     cand &= cand - 1u;
                     if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
-                    if (!rc__hit_offer(&hits[lane], t, u, v, refs[child + c], child + c, geom, inst)) continue;
+                    if (!rc__hit_offer_slot(&hits[lane], t, u, v, refs, child + c, geom, inst)) continue;
                     L.tmax[lane] = t;
                     found[lane] = 1;
+                    shrunk = 1;
                 }
             }
-            if (P.usable) { /* hits only shrink tmax: tighten the packet's bound */
+            if (shrunk && P.usable) { /* hits only shrink tmax: tighten the packet's bound */
                 uint32_t q2;
                 P.tmax = L.tmax[0];
                 for (q2 = 1; q2 < n; ++q2) P.tmax = L.tmax[q2] > P.tmax ? L.tmax[q2] : P.tmax;
@@ -382,4 +366,5 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
         count = stack[sp].count;
         mask = stack[sp].mask;
     }
+    for (i = 0; i < n; ++i) rc__hit_settle(&hits[i], refs);
 }

@@ -207,14 +207,17 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (t > tcur || !rc__hit_offer(hit, t, u, v, refs[j], j, geom, inst)) continue;
+                if (t > tcur || !rc__hit_offer_slot(hit, t, u, v, refs, j, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }
         }
     pop:
         for (;;) {
-            if (sp == 0) return found;
+            if (sp == 0) {
+                if (found) rc__hit_settle(hit, refs);
+                return found;
+            }
             --sp;
             /* with the box test's slack: a box whose entry distance rounds
              * just above t may still hold a triangle at t (a tie) */
