@@ -12,6 +12,12 @@
 #include <string.h>
 
 #include "bvh/bvh.h"
+#include "core/arena.h"
+#include "core/threads.h"
+
+#if defined(RANGECAST_WITH_THREADS)
+#include <pthread.h>
+#endif
 
 /* ---- helpers --------------------------------------------------------------- */
 
@@ -491,6 +497,83 @@ static void test_progress(void **state)
     free(boxes);
 }
 
+/* The build spread over a pool writes the serial build's tree bit for bit,
+ * for every thread count, shape and leaf size, and reports progress in order,
+ * on the calling thread only, ending at 1. */
+typedef struct mt_progress {
+    progress_log log;
+#if defined(RANGECAST_WITH_THREADS)
+    pthread_t caller;
+#endif
+    int foreign_thread;
+} mt_progress;
+
+static int on_progress_mt(void *user, const char *stage, double fraction)
+{
+    mt_progress *p = user;
+#if defined(RANGECAST_WITH_THREADS)
+    if (!pthread_equal(pthread_self(), p->caller)) p->foreign_thread = 1;
+#endif
+    return on_progress(&p->log, stage, fraction);
+}
+
+static void test_parallel_same_tree(void **state)
+{
+    static const enum shape shapes[] = {SHAPE_RANDOM, SHAPE_WITH_EMPTY, SHAPE_SAME, SHAPE_EXPONENTIAL, SHAPE_LINE};
+    static const uint32_t leaves[] = {4, 1};
+    const uint32_t n = 70001; /* odd: one leaf holds the remainder */
+    rc__aabb *boxes = malloc(sizeof *boxes * n);
+    uint32_t si, li, threads;
+    (void)state;
+    assert_non_null(boxes);
+    for (si = 0; si < sizeof shapes / sizeof shapes[0]; ++si) {
+        rng_state = 77 + si;
+        make_boxes(boxes, n, shapes[si]);
+        for (li = 0; li < 2; ++li) {
+            built serial;
+            build(&serial, boxes, n, leaves[li], 0);
+            for (threads = 2; threads <= 4; ++threads) {
+                const size_t bytes = rc__pool_memory(threads) + 4096;
+                void *block = malloc(bytes);
+                rc__arena arena;
+                rc__pool *pool = NULL;
+                built b;
+                mt_progress prog;
+                const uint32_t nodes = rc__bvh_node_count(n, leaves[li]);
+                assert_non_null(block);
+                rc__arena_init(&arena, block, bytes);
+                assert_int_equal(rc__pool_create(&arena, threads, &pool), RC_OK);
+                memset(&prog, 0, sizeof prog);
+#if defined(RANGECAST_WITH_THREADS)
+                prog.caller = pthread_self();
+#endif
+                b.bvh.nodes = malloc(sizeof(rc__bvh_node) * nodes);
+                b.bvh.refs = malloc(sizeof(uint32_t) * n);
+                b.scratch = malloc(rc__bvh_build_scratch_bytes(n));
+                assert_non_null(b.bvh.nodes);
+                assert_non_null(b.bvh.refs);
+                assert_non_null(b.scratch);
+                memset(b.bvh.nodes, 0x5a, sizeof(rc__bvh_node) * nodes);
+                rc__bvh_build_mt(boxes, n, leaves[li], b.scratch, &b.bvh, pool, on_progress_mt, &prog);
+                assert_int_equal(b.bvh.node_count, serial.bvh.node_count);
+                assert_memory_equal(b.bvh.nodes, serial.bvh.nodes, sizeof(rc__bvh_node) * nodes);
+                assert_memory_equal(b.bvh.refs, serial.bvh.refs, sizeof(uint32_t) * n);
+                assert_int_equal(prog.log.bad_stage, 0);
+                assert_int_equal(prog.log.decreasing, 0);
+                assert_int_equal(prog.foreign_thread, 0);
+                assert_true(prog.log.calls >= 2);
+                assert_true(prog.log.last == 1.0);
+                release(&b);
+                rc__pool_destroy(&arena, pool);
+                free(block);
+            }
+            check_tree(&serial.bvh, boxes, n, leaves[li]);
+            release(&serial);
+        }
+    }
+    free(boxes);
+}
+
 /* A large build: exact sizes, the invariants, and a sensible depth. */
 static void test_large(void **state)
 {
@@ -518,6 +601,7 @@ int main(void)
         cmocka_unit_test(test_sah_quality),
         cmocka_unit_test(test_refit),
         cmocka_unit_test(test_progress),
+        cmocka_unit_test(test_parallel_same_tree),
         cmocka_unit_test(test_large),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

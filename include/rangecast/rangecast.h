@@ -346,7 +346,9 @@ RC_API rc_status rc_scene_set_instance_transform(rc_scene *scene, uint32_t inst_
  * before simulate. progress may be NULL. Returns RC_ERR_OUT_OF_MEMORY when the
  * arena cannot hold the structure (the scene then stays uncommitted),
  * RC_ERR_INVALID_ARGUMENT for an empty scene, RC_ERR_NOT_COMMITTED when an
- * instanced source scene is not committed. */
+ * instanced source scene is not committed. The built-in builder runs on the
+ * context's threads and makes the same tree for any thread count; progress is
+ * called on the caller's thread only. */
 RC_API rc_status rc_scene_commit(rc_scene *scene);
 RC_API rc_status rc_scene_commit_with_progress(rc_scene *scene, rc_progress_fn progress, void *user);
 

@@ -13,6 +13,12 @@
  *      (centroid on the axis, item index) so the result is deterministic. The
  *      partition pass also gathers both children's bounds and centroid bounds,
  *      so no other pass over the items is needed.
+ * Node numbers are fixed by leaf counts alone: a node's children are the pair
+ * at its descendants' base, the left child's descendants follow the pair and
+ * the right child's follow those (rc__split_task). Every subtree thus owns a
+ * node range known before it is built, which lets rc__bvh_build_mt build the
+ * subtrees below the top levels on the context's threads and still write the
+ * serial build's tree, bit for bit.
  * Items live in scratch as 32-byte records (box + index) that are moved, so
  * every pass reads memory sequentially; refs are written from them at the end.
  * Centroids are kept doubled (min + max), which is exact enough and saves the
@@ -53,6 +59,8 @@ typedef struct rc__task {
     uint32_t begin;
     uint32_t end;
     uint32_t depth;
+    uint32_t base;  /* first node of its descendants: [base, base + 2 * leaves - 2) */
+    uint32_t pad;
     float cmin[3]; /* bounds of the doubled centroids */
     float cmax[3];
 } rc__task;
@@ -198,7 +206,6 @@ typedef struct rc__builder {
     rc__build_item *items;
     rc__bvh_node *nodes;
     uint32_t leaf;
-    uint32_t next_node;
     uint32_t placed;
     uint32_t next_report;
     uint32_t report_step;
@@ -410,11 +417,13 @@ static void rc__split(rc__builder *b, const rc__task *t, int axis, uint32_t k, i
     for (i = k; i < n; ++i) rc__acc_add(right, &it[i]);
 }
 
-static void rc__task_init(rc__task *t, uint32_t node, uint32_t begin, uint32_t end, uint32_t depth,
-                          const rc__acc *a)
+static void rc__task_init(rc__task *t, uint32_t node, uint32_t base, uint32_t begin, uint32_t end,
+                          uint32_t depth, const rc__acc *a)
 {
     int k;
     t->node = node;
+    t->base = base;
+    t->pad = 0;
     t->begin = begin;
     t->end = end;
     t->depth = depth;
@@ -424,14 +433,160 @@ static void rc__task_init(rc__task *t, uint32_t node, uint32_t begin, uint32_t e
     }
 }
 
+/* Splits task t's node into its two children (boxes written, the node made
+ * interior) and describes them in *l and *r. Node numbers depend only on leaf
+ * counts: the children are the pair (base, base + 1), the left one's
+ * descendants follow them, the right one's follow those. So every subtree
+ * owns a range of nodes fixed before it is built, and subtrees can be built in
+ * any order, on any thread, into the same array. */
+static void rc__split_task(rc__builder *b, const rc__task *t, rc__task *l, rc__task *r)
+{
+    float scale[3] = {0.0f, 0.0f, 0.0f};
+    uint32_t nb = 0, kleft = 0;
+    int uses_bins, axis;
+    rc__acc left, right;
+    const uint32_t c = t->base;
+    uint32_t ll;
+    axis = rc__choose_split(b, t, scale, &nb, &kleft, &uses_bins);
+    rc__split(b, t, axis, kleft, uses_bins, scale[axis], nb, &left, &right);
+    ll = kleft / b->leaf; /* kleft is a multiple of the leaf size */
+    b->nodes[t->node].index = c;
+    b->nodes[t->node].count = 0;
+    rc__set_node_box(&b->nodes[c], &left);
+    rc__set_node_box(&b->nodes[c + 1], &right);
+    rc__task_init(l, c, c + 2u, t->begin, t->begin + kleft, t->depth + 1, &left);
+    rc__task_init(r, c + 1, c + 2u + 2u * ll - 2u, t->begin + kleft, t->end, t->depth + 1, &right);
+}
+
+/* Builds the subtree of task t (its node's box is set). */
+static void rc__build_subtree(rc__builder *b, rc__task cur)
+{
+    rc__task stack[RC__STACK];
+    uint32_t sp = 0;
+    const uint32_t leaf_size = b->leaf;
+    if (cur.end - cur.begin <= leaf_size) {
+        rc__make_leaf(b, cur.node, cur.begin, cur.end);
+        return;
+    }
+    for (;;) {
+        rc__task tl, tr;
+        int lleaf, rleaf;
+        rc__split_task(b, &cur, &tl, &tr);
+        lleaf = tl.end - tl.begin <= leaf_size;
+        rleaf = tr.end - tr.begin <= leaf_size;
+        if (lleaf) rc__make_leaf(b, tl.node, tl.begin, tl.end);
+        if (rleaf) rc__make_leaf(b, tr.node, tr.begin, tr.end);
+        if (!lleaf && !rleaf) {
+            /* continue with the smaller: the stack stays O(log n) */
+            if (tl.end - tl.begin <= tr.end - tr.begin) {
+                stack[sp++] = tr;
+                cur = tl;
+            } else {
+                stack[sp++] = tl;
+                cur = tr;
+            }
+        } else if (!lleaf) {
+            cur = tl;
+        } else if (!rleaf) {
+            cur = tr;
+        } else if (sp > 0) {
+            cur = stack[--sp];
+        } else {
+            return;
+        }
+    }
+}
+
+/* Subtrees handed to the pool: about this many per thread (they differ in
+ * size, and the pool hands them out as threads free up), none smaller than
+ * RC__PARALLEL_MIN_ITEMS (below that a thread's start-up is not worth it). */
+#define RC__TASKS_PER_THREAD 8u
+#define RC__PARALLEL_MIN_ITEMS 8192u
+#define RC__MAX_PARALLEL_TASKS 256u
+
+typedef struct rc__parallel_build {
+    const rc__builder *proto;  /* shared arrays and leaf size */
+    const rc__task *tasks;
+    uint32_t first;            /* tasks of this round: first + task index */
+} rc__parallel_build;
+
+static void rc__subtree_task(void *user, uint32_t task, uint32_t thread)
+{
+    const rc__parallel_build *pb = (const rc__parallel_build *)user;
+    rc__builder b = *pb->proto; /* own bins; progress is the caller's */
+    (void)thread;
+    b.progress = NULL;
+    rc__build_subtree(&b, pb->tasks[pb->first + task]);
+}
+
+/* Largest task first; equal sizes by node number (deterministic). */
+static int rc__task_before(const rc__task *a, const rc__task *b)
+{
+    const uint32_t na = a->end - a->begin, nb = b->end - b->begin;
+    return na != nb ? na > nb : a->node < b->node;
+}
+
+/* Splits the largest subtrees on the calling thread until there are enough
+ * for the pool, then builds them on the pool a round at a time, reporting
+ * progress between rounds (progress is only ever called on the caller's
+ * thread). The tree is the one the serial build makes, bit for bit: each
+ * subtree's result depends only on its own items, and its node range is fixed
+ * by the leaf counts (rc__split_task). */
+static void rc__build_parallel(rc__builder *b, const rc__task *root, rc__pool *pool, uint32_t threads)
+{
+    rc__task tasks[RC__MAX_PARALLEL_TASKS];
+    uint32_t count = 1, want = threads * RC__TASKS_PER_THREAD, i, j, done;
+    rc__parallel_build pb;
+    if (want > RC__MAX_PARALLEL_TASKS - 1u) want = RC__MAX_PARALLEL_TASKS - 1u;
+    tasks[0] = *root;
+    while (count < want) {
+        rc__task t, l, r;
+        /* tasks[0 .. count) stay sorted by rc__task_before */
+        if (tasks[0].end - tasks[0].begin < RC__PARALLEL_MIN_ITEMS) break;
+        t = tasks[0];
+        for (i = 1; i < count; ++i) tasks[i - 1] = tasks[i];
+        --count;
+        rc__split_task(b, &t, &l, &r);
+        for (j = 0; j < 2; ++j) {
+            const rc__task *c = j ? &r : &l;
+            if (c->end - c->begin <= b->leaf) {
+                rc__make_leaf(b, c->node, c->begin, c->end);
+                continue;
+            }
+            for (i = count; i > 0 && rc__task_before(c, &tasks[i - 1]); --i) tasks[i] = tasks[i - 1];
+            tasks[i] = *c;
+            ++count;
+        }
+        if (count == 0) return;
+    }
+    pb.proto = b;
+    pb.tasks = tasks;
+    for (done = 0; done < count;) {
+        uint32_t n = count - done < 2u * threads ? count - done : 2u * threads;
+        pb.first = done;
+        rc__pool_run(pool, n, rc__subtree_task, &pb);
+        for (i = done; i < done + n; ++i) b->placed += tasks[i].end - tasks[i].begin;
+        done += n;
+        if (b->progress && done < count) {
+            b->progress(b->progress_user, "bvh build", (double)b->placed / (double)b->total);
+            b->reported = b->placed;
+        }
+    }
+}
+
 void rc__bvh_build(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_size, void *scratch,
                    rc__bvh *out, rc_progress_fn progress, void *progress_user)
 {
+    rc__bvh_build_mt(item_bounds, items, leaf_size, scratch, out, NULL, progress, progress_user);
+}
+
+void rc__bvh_build_mt(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_size, void *scratch,
+                      rc__bvh *out, rc__pool *pool, rc_progress_fn progress, void *progress_user)
+{
     rc__builder b;
-    rc__task stack[RC__STACK];
-    rc__task cur;
+    rc__task root_task;
     rc__acc root;
-    uint32_t sp = 0, i;
+    uint32_t i, threads = pool ? rc__pool_thread_count(pool) : 1u;
 
     if (leaf_size == 0) leaf_size = 1;
     out->item_count = items;
@@ -443,7 +598,6 @@ void rc__bvh_build(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_si
     b.items = (rc__build_item *)scratch;
     b.nodes = out->nodes;
     b.leaf = leaf_size;
-    b.next_node = 1;
     b.placed = 0;
     b.total = items;
     b.report_step = items / 20 ? items / 20 : 1;
@@ -475,51 +629,11 @@ void rc__bvh_build(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_si
     if (progress) progress(progress_user, "bvh build", 0.0);
 
     rc__set_node_box(&b.nodes[0], &root);
-    rc__task_init(&cur, 0, 0, items, 0, &root);
-    if (items <= leaf_size) {
-        rc__make_leaf(&b, 0, 0, items);
+    rc__task_init(&root_task, 0, 1, 0, items, 0, &root);
+    if (threads > 1 && items >= 2u * RC__PARALLEL_MIN_ITEMS) {
+        rc__build_parallel(&b, &root_task, pool, threads);
     } else {
-        for (;;) {
-            float scale[3] = {0.0f, 0.0f, 0.0f};
-            uint32_t nb = 0, kleft = 0, c;
-            int uses_bins, axis, lleaf, rleaf;
-            rc__acc left, right;
-            rc__task tl, tr;
-
-            axis = rc__choose_split(&b, &cur, scale, &nb, &kleft, &uses_bins);
-            rc__split(&b, &cur, axis, kleft, uses_bins, scale[axis], nb, &left, &right);
-            c = b.next_node;
-            b.next_node += 2;
-            b.nodes[cur.node].index = c;
-            b.nodes[cur.node].count = 0;
-            rc__set_node_box(&b.nodes[c], &left);
-            rc__set_node_box(&b.nodes[c + 1], &right);
-            rc__task_init(&tl, c, cur.begin, cur.begin + kleft, cur.depth + 1, &left);
-            rc__task_init(&tr, c + 1, cur.begin + kleft, cur.end, cur.depth + 1, &right);
-
-            lleaf = kleft <= leaf_size;
-            rleaf = tr.end - tr.begin <= leaf_size;
-            if (lleaf) rc__make_leaf(&b, tl.node, tl.begin, tl.end);
-            if (rleaf) rc__make_leaf(&b, tr.node, tr.begin, tr.end);
-            if (!lleaf && !rleaf) {
-                /* continue with the smaller: the stack stays O(log n) */
-                if (tl.end - tl.begin <= tr.end - tr.begin) {
-                    stack[sp++] = tr;
-                    cur = tl;
-                } else {
-                    stack[sp++] = tl;
-                    cur = tr;
-                }
-            } else if (!lleaf) {
-                cur = tl;
-            } else if (!rleaf) {
-                cur = tr;
-            } else if (sp > 0) {
-                cur = stack[--sp];
-            } else {
-                break;
-            }
-        }
+        rc__build_subtree(&b, root_task);
     }
     for (i = 0; i < items; ++i) out->refs[i] = b.items[i].id;
     if (progress && b.reported != items) progress(progress_user, "bvh build", 1.0);

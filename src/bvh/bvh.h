@@ -15,6 +15,7 @@
 #ifndef RC_BVH_BVH_H
 #define RC_BVH_BVH_H
 
+#include "core/threads.h"
 #include "rangecast/rangecast.h"
 
 #include <stddef.h>
@@ -60,6 +61,13 @@ size_t rc__bvh_build_scratch_bytes(uint32_t items);
  * The result depends only on the inputs (deterministic). progress may be NULL. */
 void rc__bvh_build(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_size, void *scratch,
                    rc__bvh *out, rc_progress_fn progress, void *progress_user);
+
+/* The same build with the subtrees below the top levels spread over pool's
+ * threads (pool NULL or one thread: on the caller's thread). The tree is the
+ * one rc__bvh_build makes, bit for bit, for any thread count; progress is
+ * called on the caller's thread only. */
+void rc__bvh_build_mt(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf_size, void *scratch,
+                      rc__bvh *out, rc__pool *pool, rc_progress_fn progress, void *progress_user);
 
 /* Recomputes every node's bounds bottom-up from new item bounds (same items). */
 void rc__bvh_refit(rc__bvh *bvh, const rc__aabb *item_bounds);

@@ -214,8 +214,8 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             mesh->bvh.nodes = wide ? scratch_nodes : nodes + node_off;
             mesh->bvh.refs = refs + ref_off;
             rc__mesh_triangle_bounds(mesh, item_bounds);
-            rc__bvh_build(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
-                          progress, user);
+            rc__bvh_build_mt(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
+                             ctx->pool, progress, user);
             {
                 uint32_t *lt = leaf_tris + 3u * ref_off, j;
                 for (j = 0; j < mesh->triangle_count; ++j)
@@ -261,7 +261,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
     }
     scene->top.nodes = nodes + l.mesh_nodes;
     scene->top.refs = refs + l.mesh_refs;
-    rc__bvh_build(item_bounds, items, RC__BVH_TOP_LEAF_SIZE, builder_scratch, &scene->top, NULL, NULL);
+    rc__bvh_build_mt(item_bounds, items, RC__BVH_TOP_LEAF_SIZE, builder_scratch, &scene->top, ctx->pool, NULL, NULL);
     {
         rc__aabb b;
         if (scene->top.node_count == 0) {
