@@ -25,6 +25,8 @@
 
 #define LANES RC__PACKET_SIZE
 #define GROUPS (LANES / 4u)
+/* lanes_tmax's SIMD paths read exactly 16 lanes */
+typedef char rc__packet_lanes_check[LANES == 16u ? 1 : -1];
 
 typedef struct packet_entry {
     uint32_t child;
@@ -42,7 +44,9 @@ typedef struct packet_lanes {
 } packet_lanes;
 
 
-/* Lanes of `mask` whose ray meets the box within [0, tmax]. */
+/* Lanes of `mask` whose ray meets the box within [0, tmax]. All four groups
+ * of lanes are tested, dead ones too: skipping them was a branch per group
+ * that mispredicted often enough to cost more than the test. */
 static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask)
 {
     const float nx = n->box[L->near_row[0]][c] - L->org[0];
@@ -57,7 +61,6 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy), vfz = _mm_set1_ps(fz);
     const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
     for (g = 0; g < GROUPS; ++g) {
-        if (!((mask >> (4u * g)) & 0xFu)) continue; /* no live lane in these four */
         const __m128 ix = _mm_load_ps(L->ix + 4 * g), iy = _mm_load_ps(L->iy + 4 * g);
         const __m128 iz = _mm_load_ps(L->iz + 4 * g);
         /* max/min return their second operand when the first is NaN: a NaN
@@ -77,7 +80,6 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
     const uint32x4_t vbits = vld1q_u32(bits);
     for (g = 0; g < GROUPS; ++g) {
-        if (!((mask >> (4u * g)) & 0xFu)) continue; /* no live lane in these four */
         const float32x4_t ix = vld1q_f32(L->ix + 4 * g), iy = vld1q_f32(L->iy + 4 * g);
         const float32x4_t iz = vld1q_f32(L->iz + 4 * g);
         float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(L->tmax + 4 * g), a;
@@ -188,13 +190,34 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
 #endif
 }
 
+/* Largest tmax over the lanes (unused lanes hold -1). */
+static inline float lanes_tmax(const packet_lanes *L)
+{
+#if defined(RC__PACKET_SSE2)
+    __m128 a = _mm_max_ps(_mm_max_ps(_mm_load_ps(L->tmax), _mm_load_ps(L->tmax + 4)),
+                          _mm_max_ps(_mm_load_ps(L->tmax + 8), _mm_load_ps(L->tmax + 12)));
+    a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(1, 0, 3, 2)));
+    a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
+    return _mm_cvtss_f32(a);
+#elif defined(RC__PACKET_NEON)
+    const float32x4_t a = vmaxq_f32(vmaxq_f32(vld1q_f32(L->tmax), vld1q_f32(L->tmax + 4)),
+                                    vmaxq_f32(vld1q_f32(L->tmax + 8), vld1q_f32(L->tmax + 12)));
+    const float32x2_t b = vpmax_f32(vget_low_f32(a), vget_high_f32(a));
+    return vget_lane_f32(vpmax_f32(b, b), 0);
+#else
+    float m = L->tmax[0];
+    uint32_t i;
+    for (i = 1; i < LANES; ++i) m = L->tmax[i] > m ? L->tmax[i] : m;
+    return m;
+#endif
+}
+
 static void packet_bounds_init(packet_bounds *P, const packet_lanes *L, uint32_t n)
 {
     const float *inv[3] = {L->ix, L->iy, L->iz};
     uint32_t i, k;
     P->usable = 1;
-    P->tmax = L->tmax[0];
-    for (i = 1; i < n; ++i) P->tmax = L->tmax[i] > P->tmax ? L->tmax[i] : P->tmax;
+    P->tmax = lanes_tmax(L);
     for (k = 0; k < 3; ++k) {
         P->ilo[k] = P->ihi[k] = inv[k][0];
         for (i = 0; i < n; ++i) {
@@ -352,11 +375,7 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                     shrunk = 1;
                 }
             }
-            if (shrunk && P.usable) { /* hits only shrink tmax: tighten the packet's bound */
-                uint32_t q2;
-                P.tmax = L.tmax[0];
-                for (q2 = 1; q2 < n; ++q2) P.tmax = L.tmax[q2] > P.tmax ? L.tmax[q2] : P.tmax;
-            }
+            if (shrunk && P.usable) P.tmax = lanes_tmax(&L); /* hits only shrink tmax: tighten the bound */
         }
         /* pop; lanes that have since found nearer hits drop out in the box
          * tests below (tmax per lane) */
