@@ -38,6 +38,92 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, c
     return count;
 }
 
+/* A leaf's (up to) four triangles transposed for the SIMD filter:
+ * c[vertex][axis][slot], slots past the leaf's count repeating slot 0. A
+ * packet transposes a leaf once and filters every live lane from it. */
+typedef struct rc__leaf4_soa {
+    float c[3][3][4];
+} rc__leaf4_soa;
+
+static RC__FORCE_INLINE void rc__leaf4_transpose(const float *const v[4][3], uint32_t count, rc__leaf4_soa *s)
+{
+    uint32_t i, vx, k;
+    for (i = 0; i < 4; ++i) {
+        const float *const *t = v[i < count ? i : 0];
+        for (vx = 0; vx < 3; ++vx)
+            for (k = 0; k < 3; ++k) s->c[vx][k][i] = t[vx][k];
+    }
+}
+
+/* Four float lanes, written once for SSE2 and NEON: the filter below uses
+ * only these operations (no fused multiply-add: products round as in C). */
+#if defined(RC__LEAF4_SSE2)
+typedef __m128 rc__v4;
+typedef __m128 rc__v4mask;
+#define RC__V4_SET1(x) _mm_set1_ps(x)
+#define RC__V4_SUB(a, b) _mm_sub_ps(a, b)
+#define RC__V4_MUL(a, b) _mm_mul_ps(a, b)
+#define RC__V4_LT(a, b) _mm_cmplt_ps(a, b)
+#define RC__V4_GT(a, b) _mm_cmpgt_ps(a, b)
+#define RC__V4_OR(a, b) _mm_or_ps(a, b)
+#define RC__V4_AND(a, b) _mm_and_ps(a, b)
+#define RC__V4_ORDERED(a, b) _mm_cmpord_ps(a, b)
+#define RC__V4_LOAD(p) _mm_loadu_ps(p)
+#define RC__V4_SETR(a, b, c, d) _mm_setr_ps(a, b, c, d)
+static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return (uint32_t)_mm_movemask_ps(m); }
+#elif defined(RC__LEAF4_NEON)
+typedef float32x4_t rc__v4;
+typedef uint32x4_t rc__v4mask;
+#define RC__V4_SET1(x) vdupq_n_f32(x)
+#define RC__V4_SUB(a, b) vsubq_f32(a, b)
+#define RC__V4_MUL(a, b) vmulq_f32(a, b)
+#define RC__V4_LT(a, b) vcltq_f32(a, b)
+#define RC__V4_GT(a, b) vcgtq_f32(a, b)
+#define RC__V4_OR(a, b) vorrq_u32(a, b)
+#define RC__V4_AND(a, b) vandq_u32(a, b)
+#define RC__V4_ORDERED(a, b) vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b))
+#define RC__V4_LOAD(p) vld1q_f32(p)
+#define RC__V4_SETR(a, b, c, d) rc__v4_setr(a, b, c, d)
+static RC__FORCE_INLINE float32x4_t rc__v4_setr(float a, float b, float c, float d)
+{
+    const float v[4] = {a, b, c, d};
+    return vld1q_f32(v);
+}
+static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
+{
+    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
+    const uint32x4_t b = vandq_u32(m, vld1q_u32(bits));
+    const uint32x2_t s2 = vorr_u32(vget_low_u32(b), vget_high_u32(b));
+    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+}
+#endif
+
+#if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
+/* Rejected lanes (bit i: triangle i) given g = the four triangles' a, b, c
+ * coordinates along kx, ky, kz (g[3 * vertex + 0/1/2]). */
+static RC__FORCE_INLINE uint32_t rc__leaf4_reject(const rc__ray *r, const rc__v4 g[9])
+{
+    const rc__v4 ox = RC__V4_SET1(r->org[r->kx]), oy = RC__V4_SET1(r->org[r->ky]), oz = RC__V4_SET1(r->org[r->kz]);
+    const rc__v4 sx = RC__V4_SET1(r->sx), sy = RC__V4_SET1(r->sy), zero = RC__V4_SET1(0.0f);
+    const rc__v4 az = RC__V4_SUB(g[2], oz), bz = RC__V4_SUB(g[5], oz), cz = RC__V4_SUB(g[8], oz);
+    const rc__v4 Ax = RC__V4_SUB(RC__V4_SUB(g[0], ox), RC__V4_MUL(sx, az));
+    const rc__v4 Ay = RC__V4_SUB(RC__V4_SUB(g[1], oy), RC__V4_MUL(sy, az));
+    const rc__v4 Bx = RC__V4_SUB(RC__V4_SUB(g[3], ox), RC__V4_MUL(sx, bz));
+    const rc__v4 By = RC__V4_SUB(RC__V4_SUB(g[4], oy), RC__V4_MUL(sy, bz));
+    const rc__v4 Cx = RC__V4_SUB(RC__V4_SUB(g[6], ox), RC__V4_MUL(sx, cz));
+    const rc__v4 Cy = RC__V4_SUB(RC__V4_SUB(g[7], oy), RC__V4_MUL(sy, cz));
+    const rc__v4 U = RC__V4_SUB(RC__V4_MUL(Cx, By), RC__V4_MUL(Cy, Bx));
+    const rc__v4 V = RC__V4_SUB(RC__V4_MUL(Ax, Cy), RC__V4_MUL(Ay, Cx));
+    const rc__v4 W = RC__V4_SUB(RC__V4_MUL(Bx, Ay), RC__V4_MUL(By, Ax));
+    const rc__v4mask neg = RC__V4_OR(RC__V4_OR(RC__V4_LT(U, zero), RC__V4_LT(V, zero)), RC__V4_LT(W, zero));
+    const rc__v4mask pos = RC__V4_OR(RC__V4_OR(RC__V4_GT(U, zero), RC__V4_GT(V, zero)), RC__V4_GT(W, zero));
+    /* a lane with a NaN (overflow) goes to the scalar test, which orders its
+     * comparisons its own way */
+    const rc__v4mask ordered = RC__V4_AND(RC__V4_ORDERED(U, V), RC__V4_ORDERED(W, W));
+    return rc__v4_bits(RC__V4_AND(RC__V4_AND(neg, pos), ordered));
+}
+#endif
+
 /* Bit i set for triangle i (< count) that rc__tri_intersect must still test;
  * v[i][0..2] are its vertices (slots >= count are ignored). */
 static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const float *const v[4][3], uint32_t count)
@@ -45,68 +131,35 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const fl
     const uint32_t all = (1u << count) - 1u;
 #if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
     const int kx = r->kx, ky = r->ky, kz = r->kz;
-    uint32_t reject;
     /* lane i: triangle i, or triangle 0 again for the slots past count */
     const float *const *p0 = v[0], *const *p1 = v[count > 1u ? 1 : 0];
     const float *const *p2 = v[count > 2u ? 2 : 0], *const *p3 = v[count > 3u ? 3 : 0];
-#define RC__LEAF4_GATHER(vtx, k) p0[vtx][k], p1[vtx][k], p2[vtx][k], p3[vtx][k]
-#if defined(RC__LEAF4_SSE2)
-    {
-        const __m128 ox = _mm_set1_ps(r->org[kx]), oy = _mm_set1_ps(r->org[ky]), oz = _mm_set1_ps(r->org[kz]);
-        const __m128 sx = _mm_set1_ps(r->sx), sy = _mm_set1_ps(r->sy), zero = _mm_setzero_ps();
-        const __m128 az = _mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(0, kz)), oz);
-        const __m128 bz = _mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(1, kz)), oz);
-        const __m128 cz = _mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(2, kz)), oz);
-        const __m128 Ax = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(0, kx)), ox), _mm_mul_ps(sx, az));
-        const __m128 Ay = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(0, ky)), oy), _mm_mul_ps(sy, az));
-        const __m128 Bx = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(1, kx)), ox), _mm_mul_ps(sx, bz));
-        const __m128 By = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(1, ky)), oy), _mm_mul_ps(sy, bz));
-        const __m128 Cx = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(2, kx)), ox), _mm_mul_ps(sx, cz));
-        const __m128 Cy = _mm_sub_ps(_mm_sub_ps(_mm_setr_ps(RC__LEAF4_GATHER(2, ky)), oy), _mm_mul_ps(sy, cz));
-        const __m128 U = _mm_sub_ps(_mm_mul_ps(Cx, By), _mm_mul_ps(Cy, Bx));
-        const __m128 V = _mm_sub_ps(_mm_mul_ps(Ax, Cy), _mm_mul_ps(Ay, Cx));
-        const __m128 W = _mm_sub_ps(_mm_mul_ps(Bx, Ay), _mm_mul_ps(By, Ax));
-        const __m128 neg = _mm_or_ps(_mm_or_ps(_mm_cmplt_ps(U, zero), _mm_cmplt_ps(V, zero)), _mm_cmplt_ps(W, zero));
-        const __m128 pos = _mm_or_ps(_mm_or_ps(_mm_cmpgt_ps(U, zero), _mm_cmpgt_ps(V, zero)), _mm_cmpgt_ps(W, zero));
-        /* a lane with a NaN (overflow) goes to the scalar test, which orders
-         * its comparisons its own way */
-        const __m128 ordered = _mm_and_ps(_mm_cmpord_ps(U, V), _mm_cmpord_ps(W, W));
-        reject = (uint32_t)_mm_movemask_ps(_mm_and_ps(_mm_and_ps(neg, pos), ordered));
-    }
-#else
-    {
-        static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
-        const float g[9][4] = {{RC__LEAF4_GATHER(0, kx)}, {RC__LEAF4_GATHER(0, ky)}, {RC__LEAF4_GATHER(0, kz)},
-                               {RC__LEAF4_GATHER(1, kx)}, {RC__LEAF4_GATHER(1, ky)}, {RC__LEAF4_GATHER(1, kz)},
-                               {RC__LEAF4_GATHER(2, kx)}, {RC__LEAF4_GATHER(2, ky)}, {RC__LEAF4_GATHER(2, kz)}};
-        const float32x4_t ox = vdupq_n_f32(r->org[kx]), oy = vdupq_n_f32(r->org[ky]), oz = vdupq_n_f32(r->org[kz]);
-        const float32x4_t sx = vdupq_n_f32(r->sx), sy = vdupq_n_f32(r->sy), zero = vdupq_n_f32(0.0f);
-        const float32x4_t az = vsubq_f32(vld1q_f32(g[2]), oz), bz = vsubq_f32(vld1q_f32(g[5]), oz);
-        const float32x4_t cz = vsubq_f32(vld1q_f32(g[8]), oz);
-        /* vmul + vsub, never vmls/vfms: the products must round as in C */
-        const float32x4_t Ax = vsubq_f32(vsubq_f32(vld1q_f32(g[0]), ox), vmulq_f32(sx, az));
-        const float32x4_t Ay = vsubq_f32(vsubq_f32(vld1q_f32(g[1]), oy), vmulq_f32(sy, az));
-        const float32x4_t Bx = vsubq_f32(vsubq_f32(vld1q_f32(g[3]), ox), vmulq_f32(sx, bz));
-        const float32x4_t By = vsubq_f32(vsubq_f32(vld1q_f32(g[4]), oy), vmulq_f32(sy, bz));
-        const float32x4_t Cx = vsubq_f32(vsubq_f32(vld1q_f32(g[6]), ox), vmulq_f32(sx, cz));
-        const float32x4_t Cy = vsubq_f32(vsubq_f32(vld1q_f32(g[7]), oy), vmulq_f32(sy, cz));
-        const float32x4_t U = vsubq_f32(vmulq_f32(Cx, By), vmulq_f32(Cy, Bx));
-        const float32x4_t V = vsubq_f32(vmulq_f32(Ax, Cy), vmulq_f32(Ay, Cx));
-        const float32x4_t W = vsubq_f32(vmulq_f32(Bx, Ay), vmulq_f32(By, Ax));
-        const uint32x4_t neg = vorrq_u32(vorrq_u32(vcltq_f32(U, zero), vcltq_f32(V, zero)), vcltq_f32(W, zero));
-        const uint32x4_t pos = vorrq_u32(vorrq_u32(vcgtq_f32(U, zero), vcgtq_f32(V, zero)), vcgtq_f32(W, zero));
-        /* a lane with a NaN (overflow) goes to the scalar test */
-        const uint32x4_t ordered = vandq_u32(vandq_u32(vceqq_f32(U, U), vceqq_f32(V, V)), vceqq_f32(W, W));
-        const uint32x4_t m = vandq_u32(vandq_u32(vandq_u32(neg, pos), ordered), vld1q_u32(bits));
-        const uint32x2_t s2 = vorr_u32(vget_low_u32(m), vget_high_u32(m));
-        reject = vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
-    }
-#endif
+#define RC__LEAF4_GATHER(vtx, k) RC__V4_SETR(p0[vtx][k], p1[vtx][k], p2[vtx][k], p3[vtx][k])
+    const rc__v4 g[9] = {RC__LEAF4_GATHER(0, kx), RC__LEAF4_GATHER(0, ky), RC__LEAF4_GATHER(0, kz),
+                         RC__LEAF4_GATHER(1, kx), RC__LEAF4_GATHER(1, ky), RC__LEAF4_GATHER(1, kz),
+                         RC__LEAF4_GATHER(2, kx), RC__LEAF4_GATHER(2, ky), RC__LEAF4_GATHER(2, kz)};
+    return all & ~rc__leaf4_reject(r, g);
 #undef RC__LEAF4_GATHER
-    return all & ~reject;
 #else
     (void)r;
     (void)v;
+    return all;
+#endif
+}
+
+/* rc__leaf4_candidates from a transposed leaf (the same tests, bit for bit). */
+static RC__FORCE_INLINE uint32_t rc__leaf4_candidates_soa(const rc__ray *r, const rc__leaf4_soa *s, uint32_t count)
+{
+    const uint32_t all = (1u << count) - 1u;
+#if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
+    const int kx = r->kx, ky = r->ky, kz = r->kz;
+    const rc__v4 g[9] = {RC__V4_LOAD(s->c[0][kx]), RC__V4_LOAD(s->c[0][ky]), RC__V4_LOAD(s->c[0][kz]),
+                         RC__V4_LOAD(s->c[1][kx]), RC__V4_LOAD(s->c[1][ky]), RC__V4_LOAD(s->c[1][kz]),
+                         RC__V4_LOAD(s->c[2][kx]), RC__V4_LOAD(s->c[2][ky]), RC__V4_LOAD(s->c[2][kz])};
+    return all & ~rc__leaf4_reject(r, g);
+#else
+    (void)r;
+    (void)s;
     return all;
 #endif
 }

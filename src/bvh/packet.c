@@ -350,19 +350,22 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
                 continue;
             }
         } else {
-            /* lane by lane: the leaf's four triangles through the SIMD
-             * filter, then the watertight test on what is left */
+            /* lane by lane: the leaf's four triangles (transposed once for
+             * all lanes) through the SIMD filter, then the watertight test on
+             * what is left */
             const float *vt[4][3];
             const uint32_t n_tri = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
+            rc__leaf4_soa soa RC__ALIGN16;
             uint32_t m = mask, lane = 0;
             int shrunk = 0;
+            rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
             for (; m; ++lane, m >>= 1) {
                 uint32_t cand;
                 while (!(m & 1u)) {
                     ++lane;
                     m >>= 1;
                 }
-                cand = rc__leaf4_candidates(&rays[lane], (const float *const(*)[3])vt, n_tri);
+                cand = rc__leaf4_candidates_soa(&rays[lane], &soa, n_tri);
                 while (cand) {
                     uint32_t c = 0;
                     float t, u, v;
