@@ -170,7 +170,10 @@ typedef struct rc_context_desc {
     /* The arena. memory != NULL: the caller's block of memory_size bytes,
      * aligned to 16 (RC_ARENA_ALIGNMENT); the library never calls malloc.
      * memory == NULL: the library mallocs memory_size bytes once, here
-     * (0 = RC_DEFAULT_ARENA_SIZE). Size it with rc_*_memory_requirements. */
+     * (0 = RC_DEFAULT_ARENA_SIZE), and on Linux advises it for transparent
+     * huge pages (large maps trace faster; a caller's block can be advised
+     * the same way with madvise(MADV_HUGEPAGE)). Size it with
+     * rc_*_memory_requirements. */
     void *memory;
     size_t memory_size;
     rc_log_fn log;          /* optional */

@@ -1,9 +1,15 @@
 /* Public context functions: create/destroy, the arena, errors, queries. */
+#if defined(__linux__) && !defined(_DEFAULT_SOURCE)
+#define _DEFAULT_SOURCE 1 /* madvise */
+#endif
 #include "backend/backend.h"
 #include "core/context.h"
 
 #include <stdlib.h>
 #include <string.h>
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
 
 #define CONTEXT_DESC_MIN_SIZE ((uint32_t)sizeof(rc_context_desc))
 
@@ -127,6 +133,17 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
         owned = malloc(size + (RC_ARENA_ALIGNMENT - 1));
         if (!owned) return create_fail(desc, RC_ERR_OUT_OF_MEMORY, "rc_context_create: malloc of the arena failed");
         block = (unsigned char *)owned + ((RC_ARENA_ALIGNMENT - (uintptr_t)owned % RC_ARENA_ALIGNMENT) % RC_ARENA_ALIGNMENT);
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+        /* Ask for transparent huge pages where the block spans whole 2 MiB
+         * pages: a large map's tree is reached at random, and fewer TLB
+         * misses measured +6% scans/s on the 10M-triangle sphere. Advice
+         * only: a kernel without THP ignores it. */
+        {
+            const uintptr_t huge = (uintptr_t)2 << 20, lo = ((uintptr_t)owned + huge - 1) & ~(huge - 1);
+            const uintptr_t hi = ((uintptr_t)owned + size) & ~(huge - 1);
+            if (hi > lo) (void)madvise((void *)lo, hi - lo, MADV_HUGEPAGE);
+        }
+#endif
     }
     rc__arena_init(&arena, block, size);
     ctx = (rc_context *)rc__arena_calloc(&arena, sizeof *ctx);
