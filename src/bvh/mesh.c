@@ -38,7 +38,7 @@ void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3])
     }
     ray->sx = dir[ray->kx] / dir[kz];
     ray->sy = dir[ray->ky] / dir[kz];
-    ray->sz = 1.0f / dir[kz];
+    ray->sz = ray->inv_dir[kz]; /* 1 / dir[kz], already computed (kz's component is the largest: not 0) */
 }
 
 static const float *rc__vertex(const rc__mesh *mesh, uint32_t i)
