@@ -3,7 +3,8 @@
 # guest instructions executed under qemu-user for aarch64 (NEON), and
 # instructions executed under valgrind (callgrind Ir) for x86_64 (SSE2), each
 # against the plain-C box tests (-DRC__PACKET_FORCE_SCALAR
-# -DRC__WIDE_FORCE_SCALAR) and against single rays without packets
+# -DRC__WIDE_FORCE_SCALAR -fno-tree-vectorize: plain C, no auto-vectorised
+# NEON/SSE either) and against single rays without packets
 # (-DRANGECAST_NO_PACKETS, SIMD box tests), on one fixed workload
 # (tools/neon-workload.c: 9,800-triangle UV sphere, 2 VLP-16 scans, 1 thread).
 #
@@ -32,7 +33,7 @@ log() { echo "neon-icount: $*" >&2; }
 variant_flags() {
     case $1 in
     simd) echo "" ;;
-    scalar) echo "-DRC__PACKET_FORCE_SCALAR -DRC__WIDE_FORCE_SCALAR" ;;
+    scalar) echo "-DRC__PACKET_FORCE_SCALAR -DRC__WIDE_FORCE_SCALAR -fno-tree-vectorize" ;;
     single) echo "-DRANGECAST_NO_PACKETS" ;;
     esac
 }
