@@ -161,3 +161,33 @@ int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count)
     if (fclose(f) != 0) return rcu_fail("%s: write error", path);
     return 0;
 }
+
+/* A point uniform in the unit ball (rejection sampling in the cube). */
+static void unit_ball(rcu_rng *rng, double p[3])
+{
+    do {
+        p[0] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+        p[1] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+        p[2] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+    } while (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > 1.0);
+}
+
+void rcu_rays_random(uint32_t count, float radius, uint64_t seed, float *origins, float *dirs)
+{
+    rcu_rng rng;
+    uint32_t i;
+    int k;
+    rcu_rng_seed(&rng, seed);
+    for (i = 0; i < count; i++) {
+        double o[3], d[3], n;
+        unit_ball(&rng, o);
+        do { /* a direction: a ball point not too near the centre, normalised */
+            unit_ball(&rng, d);
+            n = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+        } while (n < 1e-3);
+        for (k = 0; k < 3; k++) {
+            origins[3u * i + (uint32_t)k] = (float)(o[k] * radius);
+            dirs[3u * i + (uint32_t)k] = (float)(d[k] / n);
+        }
+    }
+}

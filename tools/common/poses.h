@@ -30,6 +30,11 @@ void rcu_poses_random(uint32_t count, float radius, uint64_t seed, rc_pose *out)
 void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const float center[3],
                             rc_pose *out);
 
+/* count incoherent rays for an OnDn sensor: origins uniform in the ball of
+ * radius about the sensor frame's origin, directions uniform on the unit
+ * sphere (both by rejection sampling; 3 floats each in origins and dirs). */
+void rcu_rays_random(uint32_t count, float radius, uint64_t seed, float *origins, float *dirs);
+
 /* The deterministic generator behind rcu_poses_random, for tests. */
 typedef struct rcu_rng {
     uint64_t s[4];

@@ -69,6 +69,7 @@ void rcu_preset_rays_free(rcu_preset_rays *rays)
 {
     if (!rays) return;
     free(rays->dirs);
+    free(rays->origins);
     memset(rays, 0, sizeof *rays);
 }
 
@@ -160,6 +161,33 @@ int rcu_preset_rays_f64(uint32_t preset, rcu_preset_rays *out)
     if (out->mount.orientation[0] == 0.0f && out->mount.orientation[1] == 0.0f &&
         out->mount.orientation[2] == 0.0f && out->mount.orientation[3] == 0.0f)
         out->mount.orientation[3] = 1.0f;
+    return 0;
+}
+
+int rcu_rays_f64(const float *origins, const float *dirs, uint32_t count, float range_min, float range_max,
+                 rcu_preset_rays *out)
+{
+    uint32_t i;
+    memset(out, 0, sizeof *out);
+    out->dirs = (double *)malloc((size_t)count * 3 * sizeof(double));
+    out->origins = (double *)malloc((size_t)count * 3 * sizeof(double));
+    if (!out->dirs || !out->origins) {
+        rcu_preset_rays_free(out);
+        return rcu_fail("out of memory for %u rays", count);
+    }
+    for (i = 0; i < count; i++) {
+        normalize_into(out->dirs + 3u * (size_t)i, dirs[3u * i], dirs[3u * i + 1], dirs[3u * i + 2]);
+        out->origins[3u * i] = origins[3u * i];
+        out->origins[3u * i + 1] = origins[3u * i + 1];
+        out->origins[3u * i + 2] = origins[3u * i + 2];
+    }
+    out->rays = count;
+    out->rows = 1;
+    out->columns = count;
+    out->model = RC_SENSOR_ONDN;
+    out->range_min = range_min;
+    out->range_max = range_max;
+    out->mount.orientation[3] = 1.0f;
     return 0;
 }
 

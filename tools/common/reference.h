@@ -34,8 +34,13 @@ typedef struct rcu_preset_rays {
     uint32_t forward_axis;  /* the viewing axis in the sensor frame: 0 (x), or 2 (z) for RC_PINHOLE_FRAME_OPTICAL */
     double range_min, range_max;
     rc_pose mount;          /* sensor_to_base */
+    double *origins;        /* OnDn (rcu_rays_f64): 3 doubles a ray, sensor frame; else NULL */
 } rcu_preset_rays;
 int rcu_preset_rays_f64(uint32_t preset, rcu_preset_rays *out);
+/* The same for an OnDn sensor of the caller's rays (directions normalised in
+ * double, origins as given), identity mount. */
+int rcu_rays_f64(const float *origins, const float *dirs, uint32_t count, float range_min, float range_max,
+                 rcu_preset_rays *out);
 void rcu_preset_rays_free(rcu_preset_rays *rays);
 
 /* Distance t along the ray o + t d (d unit) to the plane of triangle v0 v1 v2,

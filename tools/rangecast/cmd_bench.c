@@ -21,6 +21,14 @@
 #define BENCH_TIMED_BYTES   ((size_t)128 << 20) /* ranges buffer of the timed loop ... */
 #define BENCH_TIMED_POSES   1000u                 /* ... and poses per rc_simulate call */
 #define BENCH_CHECK_BYTES   ((size_t)64 << 20)  /* buffers of the accuracy pass */
+/* --sensor random-ondn: incoherent OnDn rays, as many as a VLP-16 scan, with
+ * origins in a ball about the sensor and VLP-16 ranges; a fixed layout (its
+ * own seed), placed by each pose like any sensor */
+#define BENCH_ONDN_RAYS     14400u
+#define BENCH_ONDN_RADIUS   5.0f
+#define BENCH_ONDN_SEED     7u
+#define BENCH_ONDN_RANGE_MIN 0.5f
+#define BENCH_ONDN_RANGE_MAX 130.0f
 
 static void usage(FILE *f)
 {
@@ -35,7 +43,9 @@ static void usage(FILE *f)
         "Options:\n"
         "  --map FILE         mesh map (.ply, or any Assimp format)\n"
         "  --poses FILE       raw poses: float32 LE x y z qx qy qz qw per pose\n"
-        "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40\n"
+        "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40;\n"
+        "                     random-ondn: 14,400 incoherent OnDn rays (origins in a 5 m ball,\n"
+        "                     random directions, fixed layout), the ray order for --ranges-out\n"
         "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
         "  --device NAME      vulkan: device index or name substring (default: first GPU, else any)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
@@ -164,7 +174,30 @@ typedef struct bench_args {
     const char *sensor_name;
     int set_triangles, set_pose_count, set_seed;
     int embree_single; /* --backend embree-single: the hand-written rtcIntersect1 loop */
+    int ondn;          /* --sensor random-ondn */
 } bench_args;
+
+/* The rays of --sensor random-ondn (sensor frame). */
+typedef struct bench_ondn {
+    float origins[3 * BENCH_ONDN_RAYS];
+    float dirs[3 * BENCH_ONDN_RAYS];
+} bench_ondn;
+
+static bench_ondn *ondn_make(void)
+{
+    bench_ondn *r = (bench_ondn *)malloc(sizeof *r);
+    if (r) rcu_rays_random(BENCH_ONDN_RAYS, BENCH_ONDN_RADIUS, BENCH_ONDN_SEED, r->origins, r->dirs);
+    return r;
+}
+
+/* The float64 reference rays of the bench's sensor. */
+static int bench_reference(const bench_args *a, const bench_ondn *ondn, rcu_preset_rays *ref)
+{
+    if (a->ondn)
+        return rcu_rays_f64(ondn->origins, ondn->dirs, BENCH_ONDN_RAYS, BENCH_ONDN_RANGE_MIN, BENCH_ONDN_RANGE_MAX,
+                            ref);
+    return rcu_preset_rays_f64(a->preset, ref);
+}
 
 static int parse_args(int argc, char **argv, bench_args *a)
 {
@@ -189,7 +222,12 @@ static int parse_args(int argc, char **argv, bench_args *a)
         else if (OPT("--ranges-out")) { if (r < 0) return -1; a->ranges_out = v; }
         else if (OPT("--sensor")) {
             if (r < 0) return -1;
-            if (rcp_parse_sensor(cmd, v, &a->preset) != 0) return -1;
+            if (strcmp(v, "random-ondn") == 0) {
+                a->ondn = 1;
+            } else if (rcp_parse_sensor(cmd, v, &a->preset) != 0) {
+                fprintf(stderr, "rangecast bench: (bench also takes random-ondn: incoherent OnDn rays)\n");
+                return -1;
+            }
             a->sensor_name = v;
         } else if (OPT("--backend")) {
             if (r < 0) return -1;
@@ -234,7 +272,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
         }
 #undef OPT
     }
-    if (a->preset == 0) a->preset = rc_preset_from_name(a->sensor_name);
+    if (a->preset == 0 && !a->ondn) a->preset = rc_preset_from_name(a->sensor_name);
     if (a->map && a->set_triangles)
         fprintf(stderr, "rangecast bench: note: --triangles is ignored with --map\n");
     if (a->poses_path && (a->set_pose_count || a->set_seed))
@@ -247,8 +285,8 @@ static int parse_args(int argc, char **argv, bench_args *a)
  * (tools/rangecast/embree_single.c), timed the same way, printed with the same
  * keys. Accuracy keys that need triangle ids are null; hit_mismatch counts
  * escaped rays on the generated sphere. */
-static int bench_embree_single(const bench_args *a, const rcu_mesh *mesh, const rc_pose *poses,
-                               uint32_t pose_count, int is_sphere)
+static int bench_embree_single(const bench_args *a, const bench_ondn *ondn, const rcu_mesh *mesh,
+                               const rc_pose *poses, uint32_t pose_count, int is_sphere)
 {
     const char *cmd = "bench";
     rcu_preset_rays ref;
@@ -259,7 +297,7 @@ static int bench_embree_single(const bench_args *a, const rcu_mesh *mesh, const 
     uint32_t threads = a->threads ? a->threads : (ncpu > 0 ? (uint32_t)ncpu : 1u);
     int rc = RCP_EXIT_FAIL;
     memset(&ref, 0, sizeof ref);
-    if (rcu_preset_rays_f64(a->preset, &ref) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
+    if (bench_reference(a, ondn, &ref) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
     n = (uint64_t)pose_count * ref.rays;
     dirs = (float *)malloc((size_t)ref.rays * 3 * sizeof(float));
     ranges = (float *)malloc((size_t)n * sizeof(float));
@@ -269,8 +307,9 @@ static int bench_embree_single(const bench_args *a, const rcu_mesh *mesh, const 
     }
     for (k = 0; k < (uint64_t)ref.rays * 3; k++) dirs[k] = (float)ref.dirs[k];
     if (rct_embree_single_bench(mesh->vertices, mesh->vertex_count, mesh->indices, mesh->triangle_count, dirs,
-                                ref.rays, (float)ref.range_min, (float)ref.range_max, poses, pose_count, threads,
-                                (int)a->repeat, &sps, &build_s, ranges) != 0) {
+                                a->ondn ? ondn->origins : NULL, ref.rays, (float)ref.range_min,
+                                (float)ref.range_max, poses, pose_count, threads, (int)a->repeat, &sps, &build_s,
+                                ranges) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
         goto out;
     }
@@ -303,6 +342,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc_pose *poses = NULL;
     uint32_t pose_count = 0, rays, batch, chunk, p, rep;
     rcp_world w;
+    bench_ondn *ondn = NULL;
     rc_sensor_info si = rc_sensor_info_default();
     rc_scene_info scinfo = rc_scene_info_default();
     rc_memory_stats ms = rc_memory_stats_default();
@@ -333,6 +373,11 @@ int rcp_cmd_bench(int argc, char **argv)
         return rcp_fail(cmd, "%s", rcu_last_error());
     }
 
+    if (a.ondn && !(ondn = ondn_make())) {
+        rcp_fail(cmd, "out of memory for the OnDn rays");
+        goto done;
+    }
+
     /* The poses. */
     if (a.poses_path) {
         if (rcu_poses_read(a.poses_path, &poses, &pose_count) != 0) {
@@ -357,11 +402,22 @@ int rcp_cmd_bench(int argc, char **argv)
 
 #if defined(RANGECAST_TOOL_WITH_EMBREE)
     if (a.embree_single) {
-        rc = bench_embree_single(&a, &mesh, poses, pose_count, is_sphere);
+        rc = bench_embree_single(&a, ondn, &mesh, poses, pose_count, is_sphere);
         goto done;
     }
 #endif
-    if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) goto done;
+    if (a.ondn) {
+        rc_rays_desc rd = rc_rays_desc_default();
+        rd.common.range_min = BENCH_ONDN_RANGE_MIN;
+        rd.common.range_max = BENCH_ONDN_RANGE_MAX;
+        rd.directions = ondn->dirs;
+        rd.origins = ondn->origins;
+        rd.ray_count = BENCH_ONDN_RAYS;
+        if (rcp_world_create_rays(cmd, a.backend, a.threads, &mesh, RC_SENSOR_ONDN, &rd, &w) != RCP_EXIT_OK)
+            goto done;
+    } else if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) {
+        goto done;
+    }
     rc_sensor_get_info(w.sensors[0], &si);
     rc_scene_get_info(w.scene, &scinfo);
     rays = si.rays_per_scan;
@@ -418,7 +474,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc_context_get_memory_stats(w.ctx, &ms);
 
     /* ---- accuracy pass (untimed) ---- */
-    if (rcu_preset_rays_f64(a.preset, &ref) != 0) {
+    if (bench_reference(&a, ondn, &ref) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
         goto done;
     }
@@ -482,18 +538,23 @@ int rcp_cmd_bench(int argc, char **argv)
                 rcu_xform_from_pose(&poses[pose_index], &pose);
                 rcu_xform_mul(&pose, &mount, &x);
                 for (r = 0; r < rays; r++) {
-                    double d[3];
+                    double d[3], o[3];
                     int hit = hh[r] != 0;
                     acc.rays++;
                     if (hit != (isfinite(rr[r]) != 0)) acc.inconsistent++;
                     rcu_xform_dir(&x, ref.dirs + 3u * (size_t)r, d);
+                    if (ref.origins) {
+                        rcu_xform_point(&x, ref.origins + 3u * (size_t)r, o);
+                    } else {
+                        memcpy(o, x.t, sizeof o);
+                    }
                     if (hit) {
                         acc.hits++;
                         if (pp[r] >= mesh.triangle_count) {
                             acc.bad_prims++;
                         } else {
                             const uint32_t *t = mesh.indices + 3u * (size_t)pp[r];
-                            double tr = rcu_ray_plane_distance(x.t, d, mesh.vertices + 3u * (size_t)t[0],
+                            double tr = rcu_ray_plane_distance(o, d, mesh.vertices + 3u * (size_t)t[0],
                                                                mesh.vertices + 3u * (size_t)t[1],
                                                                mesh.vertices + 3u * (size_t)t[2]);
                             double e = fabs((double)rr[r] - tr);
@@ -507,8 +568,8 @@ int rcp_cmd_bench(int argc, char **argv)
                         }
                     }
                     if (is_sphere) {
-                        double t_out = rcu_ray_sphere_exit(x.t, d, BENCH_SPHERE_RADIUS * (1.0 + 1e-6));
-                        double t_in = rcu_ray_sphere_exit(x.t, d, sphere_in);
+                        double t_out = rcu_ray_sphere_exit(o, d, BENCH_SPHERE_RADIUS * (1.0 + 1e-6));
+                        double t_in = rcu_ray_sphere_exit(o, d, sphere_in);
                         int must_hit = t_out <= ref.range_max && t_in >= ref.range_min;
                         int must_miss = t_in > ref.range_max || t_out < ref.range_min;
                         if ((must_hit && !hit) || (must_miss && hit)) acc.mismatch++;
@@ -589,6 +650,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc = RCP_EXIT_OK;
 
 done:
+    free(ondn);
     if (rout) fclose(rout);
     rcp_world_destroy(&w);
     rcu_preset_rays_free(&ref);

@@ -21,6 +21,7 @@
 typedef struct single_job {
     RTCScene scene;
     const float *directions;
+    const float *origins;   /* NULL: the pose's position */
     uint32_t ray_count;
     float range_min, range_max;
     const rc_pose *poses;
@@ -72,6 +73,12 @@ static void *single_worker(void *arg)
                 rh.ray.org_x = pose->position[0];
                 rh.ray.org_y = pose->position[1];
                 rh.ray.org_z = pose->position[2];
+                if (job->origins) {
+                    const float *o = job->origins + (size_t)i * 3u;
+                    rh.ray.org_x += r[0] * o[0] + r[1] * o[1] + r[2] * o[2];
+                    rh.ray.org_y += r[3] * o[0] + r[4] * o[1] + r[5] * o[2];
+                    rh.ray.org_z += r[6] * o[0] + r[7] * o[1] + r[8] * o[2];
+                }
                 rh.ray.dir_x = r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
                 rh.ray.dir_y = r[3] * d[0] + r[4] * d[1] + r[5] * d[2];
                 rh.ray.dir_z = r[6] * d[0] + r[7] * d[1] + r[8] * d[2];
@@ -108,7 +115,8 @@ static int embree_failed(RTCDevice device, const char *what)
 }
 
 int rct_embree_single_bench(const float *vertices, uint32_t vertex_count, const uint32_t *indices,
-                            uint32_t triangle_count, const float *directions, uint32_t ray_count,
+                            uint32_t triangle_count, const float *directions, const float *origins,
+                            uint32_t ray_count,
                             float range_min, float range_max, const rc_pose *poses, uint32_t pose_count,
                             uint32_t threads, int repeat, double *scans_per_s, double *build_s,
                             float *ranges_out)
@@ -177,6 +185,7 @@ int rct_embree_single_bench(const float *vertices, uint32_t vertex_count, const 
     for (t = 0; t < threads; ++t) {
         jobs[t].scene = scene;
         jobs[t].directions = directions;
+        jobs[t].origins = origins;
         jobs[t].ray_count = ray_count;
         jobs[t].range_min = range_min;
         jobs[t].range_max = range_max;

@@ -25,12 +25,15 @@
  *   the timing covers all of them.
  * scans_per_s: pose_count * repeat / wall seconds of tracing.
  * build_s: wall seconds of device, buffers and rtcCommitScene.
+ * origins: NULL (every ray starts at the pose's position), or 3 floats a
+ *   ray in the sensor frame (OnDn), placed by the pose like the directions.
  * ranges_out: NULL, or pose_count * ray_count floats receiving the last
  *   repeat's ranges (index pose * ray_count + ray).
  * Returns 0, or -1 with the reason in rcu_last_error() (bad argument, Embree
  * error, thread start failure). */
 int rct_embree_single_bench(const float *vertices, uint32_t vertex_count, const uint32_t *indices,
-                            uint32_t triangle_count, const float *directions, uint32_t ray_count,
+                            uint32_t triangle_count, const float *directions, const float *origins,
+                            uint32_t ray_count,
                             float range_min, float range_max, const rc_pose *poses, uint32_t pose_count,
                             uint32_t threads, int repeat, double *scans_per_s, double *build_s,
                             float *ranges_out);

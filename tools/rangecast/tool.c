@@ -251,8 +251,32 @@ void rcp_world_destroy(rcp_world *world)
 
 const char *rcp_device = NULL;
 
+int rcp_rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes)
+{
+    rc_status st = rc_sensor_memory_requirements_rays(model, rays, bytes);
+    if (st != RC_OK) return rcp_lib_error(cmd, NULL, "rc_sensor_memory_requirements_rays", st);
+    return RCP_EXIT_OK;
+}
+
+static int world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                        const uint32_t *presets, uint32_t preset_count, uint32_t rays_model,
+                        const rc_rays_desc *rays, rcp_world *w);
+
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *w)
+{
+    return world_create(cmd, backend, threads, mesh, presets, preset_count, 0, NULL, w);
+}
+
+int rcp_world_create_rays(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                          uint32_t model, const rc_rays_desc *rays, rcp_world *w)
+{
+    return world_create(cmd, backend, threads, mesh, NULL, 0, model, rays, w);
+}
+
+static int world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                        const uint32_t *presets, uint32_t preset_count, uint32_t rays_model,
+                        const rc_rays_desc *rays, rcp_world *w)
 {
     rc_context_desc cd = rc_context_desc_default();
     rc_status st;
@@ -263,6 +287,11 @@ int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const 
     if (rcp_arena_bytes(cmd, backend, threads, mesh, presets, preset_count, &w->arena_bytes,
                         &w->scene_bytes) != RCP_EXIT_OK)
         return RCP_EXIT_FAIL;
+    if (rays) {
+        size_t b = 0;
+        if (rcp_rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
+        w->arena_bytes += b;
+    }
     cd.backend = backend;
     cd.device = rcp_device;
     cd.thread_count = threads;
@@ -295,6 +324,11 @@ int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const 
     call = "rc_sensor_create_preset";
     for (k = 0; k < preset_count; k++) {
         if ((st = rc_sensor_create_preset(w->ctx, presets[k], &w->sensors[k])) != RC_OK) goto fail;
+        w->sensor_count++;
+    }
+    if (rays) {
+        call = "rc_sensor_create_rays";
+        if ((st = rc_sensor_create_rays(w->ctx, rays_model, rays, &w->sensors[w->sensor_count])) != RC_OK) goto fail;
         w->sensor_count++;
     }
     return RCP_EXIT_OK;

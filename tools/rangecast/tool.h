@@ -76,12 +76,18 @@ extern const char *rcp_device;
 
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *world);
+/* The same with one OnDn/O1Dn sensor of the caller's rays instead of presets
+ * (model RC_SENSOR_ONDN or RC_SENSOR_O1DN); it is world->sensors[0]. */
+int rcp_world_create_rays(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
+                          uint32_t model, const rc_rays_desc *rays, rcp_world *world);
 void rcp_world_destroy(rcp_world *world);
 
 /* Exact arena bytes of a context + one scene of this mesh on a backend
  * (threads as given), without building anything. */
 int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                     const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes);
+/* Bytes a sensor of the caller's rays adds to rcp_arena_bytes' figure. */
+int rcp_rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes);
 
 /* Median of v[0..n) (sorts v); NaN when n is 0. */
 double rcp_median(double *v, size_t n);
