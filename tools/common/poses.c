@@ -51,6 +51,16 @@ void rcu_poses_random(uint32_t count, float radius, uint64_t seed, rc_pose *out)
     rcu_poses_random_about(count, radius, seed, NULL, out);
 }
 
+/* A point uniform in the unit ball (rejection sampling in the cube). */
+static void unit_ball(rcu_rng *rng, double p[3])
+{
+    do {
+        p[0] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+        p[1] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+        p[2] = 2.0 * rcu_rng_uniform(rng) - 1.0;
+    } while (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > 1.0);
+}
+
 void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const float center[3],
                             rc_pose *out)
 {
@@ -58,17 +68,12 @@ void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const f
     uint32_t i;
     rcu_rng_seed(&rng, seed);
     for (i = 0; i < count; i++) {
-        double x, y, z, u1, u2, u3, a, b;
-        /* rejection sampling in the cube: uniform in the ball, no transcendental
-         * functions, so the positions are bit-identical everywhere */
-        do {
-            x = 2.0 * rcu_rng_uniform(&rng) - 1.0;
-            y = 2.0 * rcu_rng_uniform(&rng) - 1.0;
-            z = 2.0 * rcu_rng_uniform(&rng) - 1.0;
-        } while (x * x + y * y + z * z > 1.0);
-        out[i].position[0] = (float)(x * radius + (center ? center[0] : 0.0f));
-        out[i].position[1] = (float)(y * radius + (center ? center[1] : 0.0f));
-        out[i].position[2] = (float)(z * radius + (center ? center[2] : 0.0f));
+        double p[3], u1, u2, u3, a, b;
+        /* no transcendental functions: the positions are bit-identical everywhere */
+        unit_ball(&rng, p);
+        out[i].position[0] = (float)(p[0] * radius + (center ? center[0] : 0.0f));
+        out[i].position[1] = (float)(p[1] * radius + (center ? center[1] : 0.0f));
+        out[i].position[2] = (float)(p[2] * radius + (center ? center[2] : 0.0f));
         /* Shoemake 1992, "Uniform random rotations" */
         u1 = rcu_rng_uniform(&rng);
         u2 = rcu_rng_uniform(&rng);
@@ -160,16 +165,6 @@ int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count)
     }
     if (fclose(f) != 0) return rcu_fail("%s: write error", path);
     return 0;
-}
-
-/* A point uniform in the unit ball (rejection sampling in the cube). */
-static void unit_ball(rcu_rng *rng, double p[3])
-{
-    do {
-        p[0] = 2.0 * rcu_rng_uniform(rng) - 1.0;
-        p[1] = 2.0 * rcu_rng_uniform(rng) - 1.0;
-        p[2] = 2.0 * rcu_rng_uniform(rng) - 1.0;
-    } while (p[0] * p[0] + p[1] * p[1] + p[2] * p[2] > 1.0);
 }
 
 void rcu_rays_random(uint32_t count, float radius, uint64_t seed, float *origins, float *dirs)

@@ -251,7 +251,8 @@ void rcp_world_destroy(rcp_world *world)
 
 const char *rcp_device = NULL;
 
-int rcp_rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes)
+/* Bytes a sensor of the caller's rays adds to rcp_arena_bytes' figure. */
+static int rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes)
 {
     rc_status st = rc_sensor_memory_requirements_rays(model, rays, bytes);
     if (st != RC_OK) return rcp_lib_error(cmd, NULL, "rc_sensor_memory_requirements_rays", st);
@@ -289,7 +290,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
         return RCP_EXIT_FAIL;
     if (rays) {
         size_t b = 0;
-        if (rcp_rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
+        if (rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
         w->arena_bytes += b;
     }
     cd.backend = backend;

@@ -86,8 +86,6 @@ void rcp_world_destroy(rcp_world *world);
  * (threads as given), without building anything. */
 int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                     const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes);
-/* Bytes a sensor of the caller's rays adds to rcp_arena_bytes' figure. */
-int rcp_rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes);
 
 /* Median of v[0..n) (sorts v); NaN when n is 0. */
 double rcp_median(double *v, size_t n);
