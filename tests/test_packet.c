@@ -1,7 +1,8 @@
 /* The packet traversal (SSE2 / NEON / scalar box tests) gives every ray
  * exactly the hit of the single-ray traversal: same t, triangle and
  * barycentrics, bit for bit, for coherent tiles, mixed-octant tiles, axis-
- * parallel rays and partial packets. */
+ * parallel rays and partial packets; so do packets taking turns
+ * (rc__mesh_intersect_packets), whatever their number and mix. */
 #include <math.h>
 #include <string.h>
 
@@ -18,24 +19,21 @@ static double uniform(void)
     return (double)(rng >> 11) / 9007199254740992.0;
 }
 
-static void compare_tile(const rc__mesh *mesh, const float org[3], const float (*dirs)[3], uint32_t n)
+static void hit_init(rc__hit *h)
 {
-    rc__ray rays[RC__PACKET_SIZE];
-    rc__hit hp[RC__PACKET_SIZE], hs;
-    int fp[RC__PACKET_SIZE], fs;
+    h->t = 1000.0f;
+    h->u = h->v = 0.0f;
+    h->prim = h->geom = h->inst = h->slot = RC_INVALID_ID;
+}
+
+/* Each ray's packet hit against the single-ray traversal's. */
+static void expect_single(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, const rc__hit *hp, const int *fp)
+{
     uint32_t i;
     for (i = 0; i < n; ++i) {
-        rc__ray_prepare(&rays[i], org, dirs[i]);
-        hp[i].t = 1000.0f;
-        hp[i].u = hp[i].v = 0.0f;
-        hp[i].prim = hp[i].geom = hp[i].inst = RC_INVALID_ID;
-        fp[i] = 0;
-    }
-    rc__mesh_intersect_packet(mesh, rays, n, 0, RC_INVALID_ID, hp, fp);
-    for (i = 0; i < n; ++i) {
-        hs.t = 1000.0f;
-        hs.u = hs.v = 0.0f;
-        hs.prim = hs.geom = hs.inst = RC_INVALID_ID;
+        rc__hit hs;
+        int fs;
+        hit_init(&hs);
         fs = rc__mesh_intersect(mesh, &rays[i], 0, RC_INVALID_ID, &hs);
         assert_int_equal(fp[i], fs);
         if (!fs) continue;
@@ -46,48 +44,127 @@ static void compare_tile(const rc__mesh *mesh, const float org[3], const float (
     }
 }
 
+/* The test map: a UV sphere with a box inside (its planes make axis-aligned
+ * cases). */
+static const float box_lo[3] = {-3.0f, -2.0f, -1.0f}, box_hi[3] = {2.0f, 4.0f, 1.5f};
+typedef struct test_map {
+    rcu_mesh m, box;
+    rc_context *ctx;
+    const rc__mesh *mesh;
+} test_map;
+
+static void map_open(test_map *t)
+{
+    rc_scene *scene;
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &t->m), 0);
+    assert_int_equal(rcu_mesh_box(box_lo, box_hi, &t->box), 0);
+    assert_int_equal(rcu_mesh_append(&t->m, &t->box), 0);
+    t->ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    scene = rct_scene_mesh(t->ctx, &t->m, RC_MESH_REFERENCE);
+    t->mesh = &scene->geoms[0].mesh;
+}
+
+static void map_close(test_map *t)
+{
+    rc_context_destroy(t->ctx);
+    rcu_mesh_free(&t->m);
+    rcu_mesh_free(&t->box);
+}
+
+/* Tile number `tile` of the test: nearby directions around a random centre;
+ * some straddle axis planes, some are widely spread, some partial, some have
+ * exact zero components or start on a box plane. Returns the ray count. */
+static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit hits[RC__PACKET_SIZE],
+                          int found[RC__PACKET_SIZE])
+{
+    float org[3], dir[3];
+    double yaw = uniform() * 6.283185307, pitch = (uniform() - 0.5) * 3.0;
+    double spread = (tile % 5 == 0) ? 0.5 : 0.02;
+    uint32_t n = (tile % 7 == 0) ? 1u + (uint32_t)(uniform() * RC__PACKET_SIZE) % RC__PACKET_SIZE : RC__PACKET_SIZE;
+    uint32_t i;
+    for (i = 0; i < 3; ++i) org[i] = (float)((uniform() - 0.5) * 12.0);
+    if (tile % 11 == 0) org[0] = box_lo[0];
+    for (i = 0; i < n; ++i) {
+        double y = yaw + (uniform() - 0.5) * spread, p = pitch + (uniform() - 0.5) * spread;
+        dir[0] = (float)(cos(p) * cos(y));
+        dir[1] = (float)(cos(p) * sin(y));
+        dir[2] = (float)sin(p);
+        if (tile % 13 == 0) dir[i % 3] = 0.0f;
+        if (tile % 17 == 0) dir[(i + 1) % 3] = -0.0f;
+        rc__ray_prepare(&rays[i], org, dir);
+        hit_init(&hits[i]);
+        found[i] = 0;
+    }
+    return n;
+}
+
 static void test_packet_equals_single(void **state)
 {
-    rcu_mesh m, box;
-    const float lo[3] = {-3.0f, -2.0f, -1.0f}, hi[3] = {2.0f, 4.0f, 1.5f};
-    rc_context *ctx;
-    rc_scene *scene;
-    const rc__mesh *mesh;
-    uint32_t tile, i, tiles = rct_quick() ? 300u : 3000u;
+    test_map t;
+    uint32_t tile, tiles = rct_quick() ? 300u : 3000u;
     (void)state;
-    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &m), 0);
-    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
-    assert_int_equal(rcu_mesh_append(&m, &box), 0);
-    ctx = rct_context(RC_BACKEND_BVH, 1, 0);
-    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
-    mesh = &scene->geoms[0].mesh;
+    map_open(&t);
     for (tile = 0; tile < tiles; ++tile) {
-        float org[3], dirs[RC__PACKET_SIZE][3];
-        /* a tile of nearby directions around a random centre; some straddle
-         * axis planes, some are widely spread, some partial */
-        double yaw = uniform() * 6.283185307, pitch = (uniform() - 0.5) * 3.0;
-        double spread = (tile % 5 == 0) ? 0.5 : 0.02;
-        uint32_t n = (tile % 7 == 0) ? 1u + (uint32_t)(uniform() * RC__PACKET_SIZE) % RC__PACKET_SIZE
-                                     : RC__PACKET_SIZE;
-        for (i = 0; i < 3; ++i) org[i] = (float)((uniform() - 0.5) * 12.0);
-        if (tile % 11 == 0) org[0] = lo[0]; /* origin on a box plane */
-        for (i = 0; i < n; ++i) {
-            double y = yaw + (uniform() - 0.5) * spread, p = pitch + (uniform() - 0.5) * spread;
-            dirs[i][0] = (float)(cos(p) * cos(y));
-            dirs[i][1] = (float)(cos(p) * sin(y));
-            dirs[i][2] = (float)sin(p);
-            if (tile % 13 == 0) dirs[i][i % 3] = 0.0f; /* exact zero components */
-            if (tile % 17 == 0) dirs[i][(i + 1) % 3] = -0.0f;
-        }
-        compare_tile(mesh, org, (const float(*)[3])dirs, n);
+        rc__ray rays[RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKET_SIZE];
+        int found[RC__PACKET_SIZE];
+        const uint32_t n = make_tile(tile, rays, hits, found);
+        rc__mesh_intersect_packet(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+        expect_single(t.mesh, rays, n, hits, found);
     }
-    rc_context_destroy(ctx);
-    rcu_mesh_free(&m);
-    rcu_mesh_free(&box);
+    map_close(&t);
+}
+
+/* Groups of 1..RC__PACKETS_IN_FLIGHT packets taking turns (each group mixes
+ * the tile kinds above, so some members fall back to the plain path). */
+static void test_packets_in_turns_equal_single(void **state)
+{
+    test_map t;
+    static rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+    static rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+    static int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+    uint32_t group, tile = 0, groups = rct_quick() ? 60u : 600u;
+    (void)state;
+    map_open(&t);
+    for (group = 0; group < groups; ++group) {
+        const uint32_t k = 1u + group % RC__PACKETS_IN_FLIGHT;
+        const rc__ray *pr[RC__PACKETS_IN_FLIGHT];
+        rc__hit *ph[RC__PACKETS_IN_FLIGHT];
+        int *pf[RC__PACKETS_IN_FLIGHT];
+        uint32_t n[RC__PACKETS_IN_FLIGHT], j;
+        for (j = 0; j < k; ++j, ++tile) {
+            n[j] = make_tile(tile, rays[j], hits[j], found[j]);
+            pr[j] = rays[j];
+            ph[j] = hits[j];
+            pf[j] = found[j];
+        }
+        rc__mesh_intersect_packets(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf);
+        for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j]);
+    }
+    map_close(&t);
+}
+
+/* Turns start above RC__INTERLEAVE_BYTES of traversal data. */
+static void test_packets_in_flight_by_size(void **state)
+{
+    rc__mesh m;
+    (void)state;
+    memset(&m, 0, sizeof m);
+    m.stride = 3;
+    m.triangle_count = 1000;
+    m.vertex_count = 500;
+    m.wide_count = 100;
+    assert_int_equal(rc__mesh_packets_in_flight(&m), 1);
+    m.triangle_count = 10000000;
+    m.vertex_count = 5000000;
+    m.wide_count = 1000000;
+    assert_int_equal(rc__mesh_packets_in_flight(&m), RC__PACKETS_IN_FLIGHT);
 }
 
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single),
+                                       cmocka_unit_test(test_packets_in_turns_equal_single),
+                                       cmocka_unit_test(test_packets_in_flight_by_size)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

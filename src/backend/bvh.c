@@ -27,6 +27,7 @@ typedef struct sim_run {
     uint32_t slices;                 /* tasks per pose */
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
+    uint32_t in_flight;              /* tiles traced at once (rc__mesh_packets_in_flight) */
 } sim_run;
 
 /* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
@@ -101,31 +102,46 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     (void)thread;
     if (last > run->tiles) last = run->tiles;
     rc__job_world_xform(job, pose, &world);
-    for (tile = first; tile < last; ++tile) {
-        uint32_t r0 = (tile / tl->grid_cols) * tl->tile_rows, c0 = (tile % tl->grid_cols) * tl->tile_cols;
-        uint32_t idx[RC__PACKET_SIZE];
-        rc__ray rays[RC__PACKET_SIZE];
-        rc__hit hits[RC__PACKET_SIZE];
-        int found[RC__PACKET_SIZE];
-        uint32_t n = 0, a, b, i;
-        for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
-            for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b) idx[n++] = (r0 + a) * sensor->columns + c0 + b;
-        for (i = 0; i < n; ++i) {
-            const float *os = sensor->origins ? sensor->origins + (size_t)idx[i] * 3u : NULL;
-            world_ray(&world, sensor->directions + (size_t)idx[i] * 3u, os, &rays[i]);
-            hit_reset(&hits[i], sensor->range_max);
-            found[i] = 0;
+    /* Tiles go in groups of run->in_flight: in a large map their packets take
+     * turns, so that one's memory fetches overlap the others' work. */
+    for (tile = first; tile < last; tile += run->in_flight) {
+        uint32_t idx[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+        rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+        int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
+        const rc__ray *prays[RC__PACKETS_IN_FLIGHT];
+        rc__hit *phits[RC__PACKETS_IN_FLIGHT];
+        int *pfound[RC__PACKETS_IN_FLIGHT];
+        uint32_t n[RC__PACKETS_IN_FLIGHT], group = last - tile < run->in_flight ? last - tile : run->in_flight;
+        uint32_t k, a, b, i;
+        for (k = 0; k < group; ++k) {
+            uint32_t r0 = ((tile + k) / tl->grid_cols) * tl->tile_rows, c0 = ((tile + k) % tl->grid_cols) * tl->tile_cols;
+            n[k] = 0;
+            for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
+                for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b)
+                    idx[k][n[k]++] = (r0 + a) * sensor->columns + c0 + b;
+            for (i = 0; i < n[k]; ++i) {
+                const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
+                world_ray(&world, sensor->directions + (size_t)idx[k][i] * 3u, os, &rays[k][i]);
+                hit_reset(&hits[k][i], sensor->range_max);
+                found[k][i] = 0;
+            }
+            prays[k] = rays[k];
+            phits[k] = hits[k];
+            pfound[k] = found[k];
         }
         if (run->packets) {
-            rc__mesh_intersect_packet(&scene->geoms[0].mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+            rc__mesh_intersect_packets(&scene->geoms[0].mesh, group, prays, n, 0, RC_INVALID_ID, phits, pfound);
         } else {
-            for (i = 0; i < n; ++i) found[i] = rc__scene_intersect(scene, &rays[i], &hits[i]);
+            for (k = 0; k < group; ++k)
+                for (i = 0; i < n[k]; ++i) found[k][i] = rc__scene_intersect(scene, &rays[k][i], &hits[k][i]);
         }
-        for (i = 0; i < n; ++i) {
-            const float *os = sensor->origins ? sensor->origins + (size_t)idx[i] * 3u : NULL;
-            rc__write_result(job, base + idx[i], sensor->directions + (size_t)idx[i] * 3u, os, found[i], &hits[i],
-                             NULL, &world);
-        }
+        for (k = 0; k < group; ++k)
+            for (i = 0; i < n[k]; ++i) {
+                const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
+                rc__write_result(job, base + idx[k][i], sensor->directions + (size_t)idx[k][i] * 3u, os, found[k][i],
+                                 &hits[k][i], NULL, &world);
+            }
     }
 }
 
@@ -144,6 +160,7 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif
+    run.in_flight = run.packets ? rc__mesh_packets_in_flight(&job->scene->geoms[0].mesh) : 1u;
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {

@@ -104,10 +104,12 @@ static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, flo
 #define RC__COLD static __attribute__((noinline, unused))
 #define RC__FORCE_INLINE inline __attribute__((always_inline))
 #define RC__ALIGN16 __attribute__((aligned(16)))
+#define RC__PREFETCH(p) __builtin_prefetch(p)
 #else
 #define RC__COLD static inline
 #define RC__FORCE_INLINE inline
 #define RC__ALIGN16
+#define RC__PREFETCH(p) ((void)(p))
 #endif
 
 /* double to float without overflow (huge coordinates). */

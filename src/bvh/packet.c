@@ -285,108 +285,205 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
     }
 }
 
+/* One packet's traversal as a resumable state, so that several packets can
+ * take turns (rc__mesh_intersect_packets). Taking turns, a packet prefetches
+ * the node it visits next, and a leaf takes two turns: the first reads its
+ * vertex indices and prefetches the vertices, the second tests them. */
+typedef struct packet_trav {
+    packet_lanes L RC__ALIGN16;
+    packet_bounds P;
+    const rc__ray *rays;
+    rc__hit *hits;
+    int *found;
+    uint32_t n, sp, child, count, mask;
+    uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
+    /* up to three pushes per level */
+    packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
+} packet_trav;
+
+/* Starts T on the root. 0 when the packet cannot run as one (empty, too
+ * large, mixed octants, no tree): the caller takes the rays another way. */
+static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
+                     int *found)
+{
+    uint32_t i;
+    if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
+    if (!one_octant(rays, n, T->L.near_row)) return 0;
+    for (i = 0; i < 3; ++i) T->L.org[i] = rays[0].org[i];
+    for (i = 0; i < LANES; ++i) {
+        const rc__ray *r = &rays[i < n ? i : 0];
+        T->L.ix[i] = r->inv_dir[0];
+        T->L.iy[i] = r->inv_dir[1];
+        T->L.iz[i] = r->inv_dir[2];
+        T->L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
+    }
+    T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
+    packet_bounds_init(&T->P, &T->L, n);
+    T->rays = rays;
+    T->hits = hits;
+    T->found = found;
+    T->n = n;
+    T->sp = 0;
+    T->child = 0;
+    T->count = 0;
+    T->staged = 0;
+    return 1;
+}
+
+/* Handles T's current node or leaf and moves to the next entry. With
+ * interleaved set (a constant at every call) it works in turns as described
+ * above. 0 when the traversal is over (prim ids settled). */
+static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint32_t geom, uint32_t inst,
+                                      int interleaved)
+{
+    const rc__wnode *nodes = mesh->wide;
+    packet_lanes *L = &T->L;
+    uint32_t child = T->child, mask = T->mask;
+    if (T->count == 0) {
+        const rc__wnode *nd = &nodes[child];
+        packet_entry e[4];
+        float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
+        uint32_t m = 0, c, j, maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
+        for (c = 0; c < 4; ++c) {
+            uint32_t mc;
+            if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
+            mc = box_mask(nd, c, L, mask);
+            if (!mc) continue;
+            e[m].child = nd->child[c];
+            e[m].count = nd->count[c];
+            e[m].mask = mc;
+            e[m].tmin = tn[c];
+            /* keep e sorted by the packet's smallest entry distance */
+            for (j = m; j > 0 && e[j].tmin < e[j - 1].tmin; --j) {
+                const packet_entry tmp = e[j];
+                e[j] = e[j - 1];
+                e[j - 1] = tmp;
+            }
+            ++m;
+        }
+        if (m > 0) {
+            for (j = m; j-- > 1;) T->stack[T->sp++] = e[j]; /* depth is capped by the builder */
+            T->child = e[0].child;
+            T->count = e[0].count;
+            T->mask = e[0].mask;
+            T->staged = 0;
+            goto next;
+        }
+    } else if (interleaved && !T->staged) {
+        const float *vt[4][3];
+        const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
+        uint32_t i;
+        for (i = 0; i < n_tri; ++i) {
+            RC__PREFETCH(vt[i][0]);
+            RC__PREFETCH(vt[i][1]);
+            RC__PREFETCH(vt[i][2]);
+        }
+        T->staged = 1;
+        return 1;
+    } else {
+        /* lane by lane: the leaf's four triangles (transposed once for all
+         * lanes) through the SIMD filter, then the watertight test on what
+         * is left */
+        const rc__ray *rays = T->rays;
+        const float *vt[4][3];
+        const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
+        rc__leaf4_soa soa RC__ALIGN16;
+        uint32_t m = mask, lane = 0;
+        int shrunk = 0;
+        rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
+        for (; m; ++lane, m >>= 1) {
+            uint32_t cand;
+            while (!(m & 1u)) {
+                ++lane;
+                m >>= 1;
+            }
+            cand = rc__leaf4_candidates_soa(&rays[lane], &soa, n_tri);
+            while (cand) {
+                uint32_t c = 0;
+                float t, u, v;
+                while (!((cand >> c) & 1u)) ++c;
+                cand &= cand - 1u;
+                if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
+                if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
+                L->tmax[lane] = t;
+                T->found[lane] = 1;
+                shrunk = 1;
+            }
+        }
+        if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L); /* hits only shrink tmax: tighten the bound */
+    }
+    /* pop; lanes that have since found nearer hits drop out in the box tests
+     * of the next turn (tmax per lane) */
+    if (T->sp == 0) {
+        uint32_t i;
+        for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
+        return 0;
+    }
+    --T->sp;
+    T->staged = 0;
+    T->child = T->stack[T->sp].child;
+    T->count = T->stack[T->sp].count;
+    T->mask = T->stack[T->sp].mask;
+next:
+    if (!interleaved) return 1;
+    if (T->count == 0) {
+        const char *p = (const char *)&nodes[T->child];
+        RC__PREFETCH(p);
+        RC__PREFETCH(p + 64);
+    } else {
+        RC__PREFETCH(mesh->leaf_tris + (size_t)3 * T->child);
+    }
+    return 1;
+}
+
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
                                uint32_t inst, rc__hit *hits, int *found)
 {
-    const rc__wnode *nodes = mesh->wide;
-    const uint32_t *refs = mesh->bvh.refs;
-    const uint32_t *leaf_tris = mesh->leaf_tris;
-    const float *vertices = mesh->vertices;
-    const size_t stride = mesh->stride;
-    packet_lanes L RC__ALIGN16;
-    packet_bounds P;
-    /* up to three pushes per level */
-    packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
-    uint32_t sp = 0, i, child = 0, count = 0, mask;
-
+    packet_trav T;
+    uint32_t i;
     if (n == 0) return;
-    if (n > LANES || nodes == NULL) {
+    if (n > LANES || mesh->wide == NULL) {
         for (i = 0; i < n; ++i) found[i] |= rc__mesh_intersect(mesh, &rays[i], geom, inst, &hits[i]);
         return;
     }
     if (mesh->wide_count == 0) return;
-    if (!one_octant(rays, n, L.near_row)) {
+    if (!trav_init(&T, mesh, rays, n, hits, found)) {
         split_by_octant(mesh, rays, n, geom, inst, hits, found);
         return;
     }
-    for (i = 0; i < 3; ++i) L.org[i] = rays[0].org[i];
-    for (i = 0; i < LANES; ++i) {
-        const rc__ray *r = &rays[i < n ? i : 0];
-        L.ix[i] = r->inv_dir[0];
-        L.iy[i] = r->inv_dir[1];
-        L.iz[i] = r->inv_dir[2];
-        L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
+    while (trav_step(&T, mesh, geom, inst, 0)) {
     }
-    mask = (n >= 32u ? 0u : (1u << n)) - 1u;
-    packet_bounds_init(&P, &L, n);
-    for (;;) {
-        if (count == 0) {
-            const rc__wnode *nd = &nodes[child];
-            packet_entry e[4];
-            float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
-            uint32_t m = 0, c, j, maybe = P.usable ? children_maybe_hit(nd, &L, &P, tn) : 0xFu;
-            for (c = 0; c < 4; ++c) {
-                uint32_t mc;
-                if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
-                mc = box_mask(nd, c, &L, mask);
-                if (!mc) continue;
-                e[m].child = nd->child[c];
-                e[m].count = nd->count[c];
-                e[m].mask = mc;
-                e[m].tmin = tn[c];
-                /* keep e sorted by the packet's smallest entry distance */
-                for (j = m; j > 0 && e[j].tmin < e[j - 1].tmin; --j) {
-                    const packet_entry tmp = e[j];
-                    e[j] = e[j - 1];
-                    e[j - 1] = tmp;
-                }
-                ++m;
-            }
-            if (m > 0) {
-                for (j = m; j-- > 1;) stack[sp++] = e[j]; /* depth is capped by the builder */
-                child = e[0].child;
-                count = e[0].count;
-                mask = e[0].mask;
-                continue;
-            }
-        } else {
-            /* lane by lane: the leaf's four triangles (transposed once for
-             * all lanes) through the SIMD filter, then the watertight test on
-             * what is left */
-            const float *vt[4][3];
-            const uint32_t n_tri = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
-            rc__leaf4_soa soa RC__ALIGN16;
-            uint32_t m = mask, lane = 0;
-            int shrunk = 0;
-            rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
-            for (; m; ++lane, m >>= 1) {
-                uint32_t cand;
-                while (!(m & 1u)) {
-                    ++lane;
-                    m >>= 1;
-                }
-                cand = rc__leaf4_candidates_soa(&rays[lane], &soa, n_tri);
-                while (cand) {
-                    uint32_t c = 0;
-                    float t, u, v;
-                    while (!((cand >> c) & 1u)) ++c;
-                    cand &= cand - 1u;
-                    if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
-                    if (!rc__hit_offer_slot(&hits[lane], t, u, v, refs, child + c, geom, inst)) continue;
-                    L.tmax[lane] = t;
-                    found[lane] = 1;
-                    shrunk = 1;
-                }
-            }
-            if (shrunk && P.usable) P.tmax = lanes_tmax(&L); /* hits only shrink tmax: tighten the bound */
-        }
-        /* pop; lanes that have since found nearer hits drop out in the box
-         * tests below (tmax per lane) */
-        if (sp == 0) break;
-        --sp;
-        child = stack[sp].child;
-        count = stack[sp].count;
-        mask = stack[sp].mask;
+}
+
+void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
+                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
+                                int *const *found)
+{
+    packet_trav T[RC__PACKETS_IN_FLIGHT];
+    uint32_t live = 0, k;
+    if (packets > RC__PACKETS_IN_FLIGHT) packets = RC__PACKETS_IN_FLIGHT;
+    if (packets == 1) {
+        rc__mesh_intersect_packet(mesh, rays[0], n[0], geom, inst, hits[0], found[0]);
+        return;
     }
-    for (i = 0; i < n; ++i) rc__hit_settle(&hits[i], refs);
+    for (k = 0; k < packets; ++k) {
+        if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k]))
+            live |= 1u << k;
+        else
+            rc__mesh_intersect_packet(mesh, rays[k], n[k], geom, inst, hits[k], found[k]);
+    }
+    /* take turns: while one packet's next node or leaf is on its way from
+     * memory, the others work */
+    while (live) {
+        for (k = 0; k < packets; ++k)
+            if (((live >> k) & 1u) && !trav_step(&T[k], mesh, geom, inst, 1)) live &= ~(1u << k);
+    }
+}
+
+uint32_t rc__mesh_packets_in_flight(const rc__mesh *mesh)
+{
+    const uint64_t bytes = (uint64_t)mesh->wide_count * sizeof(rc__wnode) +
+                           (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
+                           (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
+    return bytes > RC__INTERLEAVE_BYTES ? RC__PACKETS_IN_FLIGHT : 1u;
 }
