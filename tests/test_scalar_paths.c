@@ -6,7 +6,9 @@
 #define RC__PACKET_FORCE_SCALAR 1
 #define rc__mesh_intersect_wide scalar_intersect_wide
 #define rc__mesh_occluded_wide scalar_occluded_wide
+#define rc__mesh_intersect_rays scalar_intersect_rays
 #include "../src/bvh/wide_trace.c"
+#undef rc__mesh_intersect_rays
 #define rc__mesh_intersect_packet scalar_intersect_packet
 #define rc__mesh_intersect_packets scalar_intersect_packets
 #define rc__mesh_packets_in_flight scalar_packets_in_flight

@@ -134,7 +134,7 @@ static void hit_init(rc__hit *h, float t)
 {
     h->t = t;
     h->u = h->v = 0.0f;
-    h->prim = h->geom = h->inst = RC_INVALID_ID;
+    h->prim = h->geom = h->inst = h->slot = RC_INVALID_ID;
 }
 
 /* One ray through both trees: same found flag and the same hit bit for bit,
@@ -160,17 +160,25 @@ static void compare_ray(const rc__mesh *wide, const rc__mesh *binary, const floa
     assert_int_equal(rc__mesh_occluded(wide, &r, FAR), rc__mesh_occluded(binary, &r, FAR));
 }
 
+/* Ray i of a random test: an origin in the sphere, a random direction,
+ * every seventh axis-parallel. */
+static void random_ray(uint32_t i, float org[3], float dir[3])
+{
+    double y = uniform() * 6.283185307, p = (uniform() - 0.5) * 3.1;
+    uint32_t k;
+    for (k = 0; k < 3; ++k) org[k] = (float)((uniform() - 0.5) * 12.0);
+    dir[0] = (float)(cos(p) * cos(y));
+    dir[1] = (float)(cos(p) * sin(y));
+    dir[2] = (float)sin(p);
+    if (i % 7 == 0) dir[i % 3] = 0.0f; /* axis-parallel */
+}
+
 static void random_rays(const rc__mesh *wide, const rc__mesh *binary, uint32_t rays)
 {
     uint32_t i, k, hits = 0;
     for (i = 0; i < rays; ++i) {
         float org[3], dir[3];
-        double y = uniform() * 6.283185307, p = (uniform() - 0.5) * 3.1;
-        for (k = 0; k < 3; ++k) org[k] = (float)((uniform() - 0.5) * 12.0);
-        dir[0] = (float)(cos(p) * cos(y));
-        dir[1] = (float)(cos(p) * sin(y));
-        dir[2] = (float)sin(p);
-        if (i % 7 == 0) dir[i % 3] = 0.0f;            /* axis-parallel */
+        random_ray(i, org, dir);
         if (i % 11 == 0) dir[(i + 1) % 3] = -0.0f;
         if (i % 13 == 0) org[0] = -3.0f;              /* on the box's plane */
         if (i % 17 == 0) {                            /* at a shared vertex of the sphere */
@@ -248,6 +256,56 @@ static void test_wide_equals_binary(void **state)
     binary_of(&scene->geoms[0].mesh, &b);
     random_rays(&scene->geoms[0].mesh, &b.mesh, rct_quick() ? 3000u : 30000u);
     binary_free(&b);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&m);
+}
+
+/* Rays taking turns (rc__mesh_intersect_rays) in runs of every length
+ * around the number in flight: each gets rc__mesh_intersect's answer, bit
+ * for bit, and its found flag; some start with a shorter tmax. */
+static void test_rays_in_turns(void **state)
+{
+    static const uint32_t runs[] = {0, 1, 5, 8, 9, 16, 37, 128};
+    rcu_mesh m;
+    rc_context *ctx;
+    rc_scene *scene;
+    const rc__mesh *mesh;
+    uint32_t round, rounds = rct_quick() ? 8u : 60u, hits_seen = 0;
+    (void)state;
+    test_mesh(&m);
+    ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    mesh = &scene->geoms[0].mesh;
+    for (round = 0; round < rounds; ++round) {
+        const uint32_t n = runs[round % (sizeof runs / sizeof runs[0])];
+        rc__ray rays[128];
+        rc__hit hits[128];
+        int found[128];
+        uint32_t i;
+        for (i = 0; i < n; ++i) {
+            float org[3], dir[3];
+            random_ray(i, org, dir);
+            rc__ray_prepare(&rays[i], org, dir);
+            hit_init(&hits[i], i % 5 == 0 ? 2.0f : FAR); /* some end before any surface */
+            found[i] = -1;
+        }
+        rc__mesh_intersect_rays(mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+        for (i = 0; i < n; ++i) {
+            rc__hit h;
+            int f;
+            hit_init(&h, i % 5 == 0 ? 2.0f : FAR);
+            f = rc__mesh_intersect(mesh, &rays[i], 0, RC_INVALID_ID, &h);
+            assert_int_equal(found[i], f);
+            hits_seen += (uint32_t)f;
+            if (!f) continue;
+            assert_int_equal(hits[i].prim, h.prim);
+            assert_int_equal(hits[i].slot, h.slot);
+            assert_memory_equal(&hits[i].t, &h.t, sizeof(float));
+            assert_memory_equal(&hits[i].u, &h.u, sizeof(float));
+            assert_memory_equal(&hits[i].v, &h.v, sizeof(float));
+        }
+    }
+    assert_true(hits_seen > 0);
     rc_context_destroy(ctx);
     rcu_mesh_free(&m);
 }
@@ -348,6 +406,7 @@ int main(void)
         cmocka_unit_test(test_collapse_structure),
         cmocka_unit_test(test_small_meshes),
         cmocka_unit_test(test_wide_equals_binary),
+        cmocka_unit_test(test_rays_in_turns),
         cmocka_unit_test(test_refit),
         cmocka_unit_test(test_add_mesh_after_commit),
     };

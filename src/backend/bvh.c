@@ -28,6 +28,7 @@ typedef struct sim_run {
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
     uint32_t in_flight;              /* tiles traced at once (rc__mesh_packets_in_flight) */
+    int rays_in_turns;               /* 1 when single rays of one large mesh take turns */
 } sim_run;
 
 /* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
@@ -132,6 +133,14 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
         }
         if (run->packets) {
             rc__mesh_intersect_packets(&scene->geoms[0].mesh, group, prays, n, 0, RC_INVALID_ID, phits, pfound);
+        } else if (run->rays_in_turns) {
+            /* full tiles lie back to back: one run keeps the turns full */
+            uint32_t full = 0;
+            while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
+            rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[0], full * RC__PACKET_SIZE + n[full], 0,
+                                    RC_INVALID_ID, hits[0], found[0]);
+            for (k = full + 1; k < group; ++k)
+                rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[k], n[k], 0, RC_INVALID_ID, hits[k], found[k]);
         } else {
             for (k = 0; k < group; ++k)
                 for (i = 0; i < n[k]; ++i) found[k][i] = rc__scene_intersect(scene, &rays[k][i], &hits[k][i]);
@@ -160,7 +169,12 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif
-    run.in_flight = run.packets ? rc__mesh_packets_in_flight(&job->scene->geoms[0].mesh) : 1u;
+    {
+        const int one_mesh = job->scene->geom_count == 1 && job->scene->inst_count == 0;
+        run.in_flight = run.packets ? rc__mesh_packets_in_flight(&job->scene->geoms[0].mesh) : 1u;
+        run.rays_in_turns = !run.packets && one_mesh && rc__mesh_is_large(&job->scene->geoms[0].mesh);
+        if (run.rays_in_turns) run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
+    }
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {

@@ -38,6 +38,31 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, c
     return count;
 }
 
+/* For traversals taking turns: the first bytes of what a ray or packet
+ * visits next (count 0: wide node `child`, both its cache lines; else the
+ * leaf's index triples), and, once those are in, a leaf's vertices. */
+static RC__FORCE_INLINE void rc__prefetch_next(const rc__wnode *nodes, const uint32_t *leaf_tris, uint32_t child,
+                                              uint32_t count)
+{
+    if (count == 0) {
+        const char *p = (const char *)&nodes[child];
+        RC__PREFETCH(p);
+        RC__PREFETCH(p + 64);
+    } else {
+        RC__PREFETCH(leaf_tris + (size_t)3 * child);
+    }
+}
+
+static RC__FORCE_INLINE void rc__leaf4_prefetch_vertices(const float *const v[4][3], uint32_t count)
+{
+    uint32_t i;
+    for (i = 0; i < count; ++i) {
+        RC__PREFETCH(v[i][0]);
+        RC__PREFETCH(v[i][1]);
+        RC__PREFETCH(v[i][2]);
+    }
+}
+
 /* A leaf's (up to) four triangles transposed for the SIMD filter:
  * c[vertex][axis][slot], slots past the leaf's count repeating slot 0. A
  * packet transposes a leaf once and filters every live lane from it. */

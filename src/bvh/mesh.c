@@ -207,3 +207,11 @@ int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax)
     if (mesh->wide) return rc__mesh_occluded_wide(mesh, ray, tmax);
     return rc__traverse(mesh, ray, 0, 0, NULL, tmax, 1);
 }
+
+int rc__mesh_is_large(const rc__mesh *mesh)
+{
+    const uint64_t bytes = (uint64_t)mesh->wide_count * sizeof(rc__wnode) +
+                           (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
+                           (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
+    return bytes > RC__LARGE_MESH_BYTES;
+}

@@ -69,6 +69,23 @@ int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t g
                             rc__hit *hit);
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 
+/* rays[0..n) one by one as rc__mesh_intersect would (found[i] = its
+ * result), but up to RC__RAYS_IN_FLIGHT of them taking turns node by node,
+ * so that one ray's memory fetches overlap the others' work: for maps larger
+ * than the caches (rc__mesh_is_large). */
+#define RC__RAYS_IN_FLIGHT 8u
+void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
+                             rc__hit *hits, int *found);
+
+/* 1 when the mesh's nodes, leaf triangles and vertices take more than
+ * RC__LARGE_MESH_BYTES, the size from which traversals taking turns pay
+ * (measured on a Xeon VM, docs/benchmarks.md: 4% slower at 1k triangles,
+ * even at 1M (37 MB, inside its 260 MB L3), +47% at 10M). 8 MiB is above the
+ * last cache level of the ARM boards this is for, where a 1M map already
+ * waits on DRAM. */
+#define RC__LARGE_MESH_BYTES (8u << 20)
+int rc__mesh_is_large(const rc__mesh *mesh);
+
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 

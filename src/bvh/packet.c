@@ -372,12 +372,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     } else if (interleaved && !T->staged) {
         const float *vt[4][3];
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
-        uint32_t i;
-        for (i = 0; i < n_tri; ++i) {
-            RC__PREFETCH(vt[i][0]);
-            RC__PREFETCH(vt[i][1]);
-            RC__PREFETCH(vt[i][2]);
-        }
+        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, n_tri);
         T->staged = 1;
         return 1;
     } else {
@@ -425,14 +420,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     T->count = T->stack[T->sp].count;
     T->mask = T->stack[T->sp].mask;
 next:
-    if (!interleaved) return 1;
-    if (T->count == 0) {
-        const char *p = (const char *)&nodes[T->child];
-        RC__PREFETCH(p);
-        RC__PREFETCH(p + 64);
-    } else {
-        RC__PREFETCH(mesh->leaf_tris + (size_t)3 * T->child);
-    }
+    if (interleaved) rc__prefetch_next(nodes, mesh->leaf_tris, T->child, T->count);
     return 1;
 }
 
@@ -482,8 +470,5 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
 
 uint32_t rc__mesh_packets_in_flight(const rc__mesh *mesh)
 {
-    const uint64_t bytes = (uint64_t)mesh->wide_count * sizeof(rc__wnode) +
-                           (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
-                           (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
-    return bytes > RC__INTERLEAVE_BYTES ? RC__PACKETS_IN_FLIGHT : 1u;
+    return rc__mesh_is_large(mesh) ? RC__PACKETS_IN_FLIGHT : 1u;
 }

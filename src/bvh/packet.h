@@ -27,14 +27,8 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
                                 int *const *found);
 
-/* How many packets to trace at once in this mesh: 1 (no turns) while its
- * nodes, leaf triangles and vertices fit in RC__INTERLEAVE_BYTES, which the
- * caches keep close, else RC__PACKETS_IN_FLIGHT. Measured on a Xeon VM
- * (docs/benchmarks.md): taking turns costs 4% at 1k triangles, is even at 1M
- * (37 MB, in its 260 MB L3) and gains 47% at 10M; 8 MiB is above the last
- * cache level of the ARM boards this is for, where a 1M map already waits
- * on DRAM. */
-#define RC__INTERLEAVE_BYTES (8u << 20)
+/* How many packets to trace at once in this mesh: RC__PACKETS_IN_FLIGHT in a
+ * large one (rc__mesh_is_large), else 1 (no turns). */
 uint32_t rc__mesh_packets_in_flight(const rc__mesh *mesh);
 
 #endif

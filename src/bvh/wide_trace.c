@@ -129,6 +129,22 @@ static RC__FORCE_INLINE uint32_t wide_box_test(const rc__wnode *n, const wide_ra
 #endif
 }
 
+/* Adds child c of n to e[0..m), kept nearest first; returns m + 1. */
+static RC__FORCE_INLINE uint32_t add_sorted(wide_entry e[4], uint32_t m, const rc__wnode *n, uint32_t c,
+                                            const float tn[4])
+{
+    uint32_t i;
+    e[m].child = n->child[c];
+    e[m].count = n->count[c];
+    e[m].tnear = tn[c];
+    for (i = m; i > 0 && e[i].tnear < e[i - 1].tnear; --i) {
+        const wide_entry t = e[i];
+        e[i] = e[i - 1];
+        e[i - 1] = t;
+    }
+    return m + 1;
+}
+
 static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                                      rc__hit *hit, float tmax, int any_hit)
 {
@@ -164,23 +180,11 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                     /* two to four met: sort by entry distance, push all but
                      * the nearest farthest-first, visit the nearest */
                     wide_entry e[4];
-                    uint32_t m = 0, i, j;
-                    e[m].child = n->child[c];
-                    e[m].count = n->count[c];
-                    e[m].tnear = tn[c];
-                    ++m;
+                    uint32_t m = add_sorted(e, 0, n, c, tn), j;
                     while (mask) {
                         c = lowest_bit(mask);
                         mask &= mask - 1u;
-                        e[m].child = n->child[c];
-                        e[m].count = n->count[c];
-                        e[m].tnear = tn[c];
-                        for (i = m; i > 0 && e[i].tnear < e[i - 1].tnear; --i) {
-                            const wide_entry t = e[i];
-                            e[i] = e[i - 1];
-                            e[i - 1] = t;
-                        }
-                        ++m;
+                        m = add_sorted(e, m, n, c, tn);
                     }
                     for (j = m; j-- > 1;) {
                         /* the builder caps depth so this always holds; a
@@ -238,4 +242,120 @@ int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t g
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax)
 {
     return wide_traverse(mesh, ray, 0, 0, NULL, tmax, 1);
+}
+
+/* Rays taking turns (rc__mesh_intersect_rays): one ray's traversal as a
+ * resumable state. A turn handles one node, or one half of a leaf: the first
+ * half reads its vertex indices and prefetches the vertices, the second tests
+ * them. After a node the ray prefetches the one it visits next. The tests,
+ * their order and the tie rule are those of wide_traverse, so every ray gets
+ * the same hit, bit for bit. */
+typedef struct ray_turns {
+    rc__ray r;
+    wide_ray w;
+    rc__hit *hit;
+    float tcur;
+    uint32_t sp, child, count, staged;
+    int found;
+    wide_entry stack[STACK_SIZE];
+} ray_turns;
+
+static void turns_start(ray_turns *T, const rc__ray *ray, rc__hit *hit)
+{
+    T->r = *ray;
+    wide_ray_init(&T->w, ray);
+    T->hit = hit;
+    T->tcur = hit->t;
+    T->sp = T->child = T->count = T->staged = 0;
+    T->found = 0;
+}
+
+/* One turn of T; 0 once its traversal is over (prim id settled). */
+static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint32_t geom, uint32_t inst)
+{
+    if (T->count == 0) {
+        const rc__wnode *n = &mesh->wide[T->child];
+        float tn[4] RC__ALIGN16;
+        uint32_t mask = wide_box_test(n, &T->w, T->tcur, tn);
+        if (mask) {
+            wide_entry e[4];
+            uint32_t m = 0, j;
+            while (mask) {
+                const uint32_t c = lowest_bit(mask);
+                mask &= mask - 1u;
+                m = add_sorted(e, m, n, c, tn);
+            }
+            for (j = m; j-- > 1;)
+                if (RC__LIKELY(T->sp < STACK_SIZE)) T->stack[T->sp++] = e[j];
+            T->child = e[0].child;
+            T->count = e[0].count;
+            T->staged = 0;
+            rc__prefetch_next(mesh->wide, mesh->leaf_tris, T->child, T->count);
+            return 1;
+        }
+    } else if (!T->staged) {
+        const float *vt[4][3];
+        const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
+        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, count);
+        T->staged = 1;
+        return 1;
+    } else {
+        const float *vt[4][3];
+        const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
+        uint32_t cand = rc__leaf4_candidates(&T->r, (const float *const(*)[3])vt, count);
+        while (cand) {
+            const uint32_t j = T->child + lowest_bit(cand);
+            const float *const *tv = vt[j - T->child];
+            float t, u, v;
+            cand &= cand - 1u;
+            if (!rc__tri_intersect(&T->r, tv[0], tv[1], tv[2], &t, &u, &v)) continue;
+            if (t > T->tcur || !rc__hit_offer_slot(T->hit, t, u, v, mesh->bvh.refs, j, geom, inst)) continue;
+            T->tcur = t;
+            T->found = 1;
+        }
+    }
+    for (;;) {
+        if (T->sp == 0) {
+            if (T->found) rc__hit_settle(T->hit, mesh->bvh.refs);
+            return 0;
+        }
+        --T->sp;
+        if (T->stack[T->sp].tnear <= T->tcur * RC__SLAB_FAR_SCALE) {
+            T->child = T->stack[T->sp].child;
+            T->count = T->stack[T->sp].count;
+            T->staged = 0;
+            rc__prefetch_next(mesh->wide, mesh->leaf_tris, T->child, T->count);
+            return 1;
+        }
+    }
+}
+
+void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
+                             rc__hit *hits, int *found)
+{
+    ray_turns T[RC__RAYS_IN_FLIGHT];
+    uint32_t slot_ray[RC__RAYS_IN_FLIGHT];
+    uint32_t next = 0, live = 0, k;
+    if (mesh->wide == NULL || mesh->wide_count == 0) {
+        for (k = 0; k < n; ++k) found[k] = rc__mesh_intersect(mesh, &rays[k], geom, inst, &hits[k]);
+        return;
+    }
+    /* a slot whose ray is done takes the next one, so the turns stay full */
+    for (k = 0; k < RC__RAYS_IN_FLIGHT && next < n; ++k, ++next) {
+        turns_start(&T[k], &rays[next], &hits[next]);
+        slot_ray[k] = next;
+        live |= 1u << k;
+    }
+    while (live) {
+        for (k = 0; k < RC__RAYS_IN_FLIGHT; ++k) {
+            if (!((live >> k) & 1u) || turns_step(&T[k], mesh, geom, inst)) continue;
+            found[slot_ray[k]] = T[k].found;
+            if (next < n) {
+                turns_start(&T[k], &rays[next], &hits[next]);
+                slot_ray[k] = next++;
+            } else {
+                live &= ~(1u << k);
+            }
+        }
+    }
 }
