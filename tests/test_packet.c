@@ -144,7 +144,8 @@ static void test_packets_in_turns_equal_single(void **state)
     map_close(&t);
 }
 
-/* Turns start above RC__INTERLEAVE_BYTES of traversal data. */
+/* Turns start above the threshold: RC__LARGE_MESH_BYTES, or an eighth of a
+ * large last-level cache. */
 static void test_packets_in_flight_by_size(void **state)
 {
     rc__mesh m;
@@ -154,11 +155,15 @@ static void test_packets_in_flight_by_size(void **state)
     m.triangle_count = 1000;
     m.vertex_count = 500;
     m.wide_count = 100;
-    assert_int_equal(rc__mesh_packets_in_flight(&m), 1);
+    assert_int_equal(rc__mesh_packets_in_flight(&m, RC__LARGE_MESH_BYTES), 1);
     m.triangle_count = 10000000;
     m.vertex_count = 5000000;
     m.wide_count = 1000000;
-    assert_int_equal(rc__mesh_packets_in_flight(&m), RC__PACKETS_IN_FLIGHT);
+    assert_int_equal(rc__mesh_packets_in_flight(&m, RC__LARGE_MESH_BYTES), RC__PACKETS_IN_FLIGHT);
+    assert_int_equal(rc__mesh_packets_in_flight(&m, (uint64_t)1 << 30), 1);
+    assert_true(rc__large_mesh_threshold(0) == RC__LARGE_MESH_BYTES);
+    assert_true(rc__large_mesh_threshold(2u << 20) == RC__LARGE_MESH_BYTES);
+    assert_true(rc__large_mesh_threshold((uint64_t)260 << 20) == (uint64_t)260 << 17);
 }
 
 int main(void)

@@ -9,6 +9,7 @@
  * the split never changes a bit. */
 #include "backend/backend.h"
 #include "bvh/packet.h"
+#include "core/cache_size.h"
 
 #include <math.h>
 #include <string.h>
@@ -171,8 +172,9 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
 #endif
     {
         const int one_mesh = job->scene->geom_count == 1 && job->scene->inst_count == 0;
-        run.in_flight = run.packets ? rc__mesh_packets_in_flight(&job->scene->geoms[0].mesh) : 1u;
-        run.rays_in_turns = !run.packets && one_mesh && rc__mesh_is_large(&job->scene->geoms[0].mesh);
+        const rc__mesh *mesh = one_mesh ? &job->scene->geoms[0].mesh : NULL;
+        run.in_flight = run.packets ? rc__mesh_packets_in_flight(mesh, ctx->large_mesh_bytes) : 1u;
+        run.rays_in_turns = !run.packets && one_mesh && rc__mesh_is_large(mesh, ctx->large_mesh_bytes);
         if (run.rays_in_turns) run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
     }
     run.slices = 1;
@@ -195,8 +197,8 @@ static size_t bvh_context_bytes(const rc_context_desc *desc)
 }
 static rc_status bvh_init(rc_context *ctx, const rc_context_desc *desc)
 {
-    (void)ctx;
     (void)desc;
+    ctx->large_mesh_bytes = rc__large_mesh_threshold(rc__last_level_cache_bytes());
     return RC_OK;
 }
 static void bvh_deinit(rc_context *ctx) { (void)ctx; }

@@ -208,10 +208,15 @@ int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax)
     return rc__traverse(mesh, ray, 0, 0, NULL, tmax, 1);
 }
 
-int rc__mesh_is_large(const rc__mesh *mesh)
+int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold)
 {
     const uint64_t bytes = (uint64_t)mesh->wide_count * sizeof(rc__wnode) +
                            (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
                            (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
-    return bytes > RC__LARGE_MESH_BYTES;
+    return bytes > threshold;
+}
+
+uint64_t rc__large_mesh_threshold(uint64_t llc)
+{
+    return llc / 8u > RC__LARGE_MESH_BYTES ? llc / 8u : RC__LARGE_MESH_BYTES;
 }

@@ -78,13 +78,18 @@ void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t
                              rc__hit *hits, int *found);
 
 /* 1 when the mesh's nodes, leaf triangles and vertices take more than
- * RC__LARGE_MESH_BYTES, the size from which traversals taking turns pay
- * (measured on a Xeon VM, docs/benchmarks.md: 4% slower at 1k triangles,
- * even at 1M (37 MB, inside its 260 MB L3), +47% at 10M). 8 MiB is above the
- * last cache level of the ARM boards this is for, where a 1M map already
- * waits on DRAM. */
+ * threshold bytes: then traversals taking turns pay. */
+int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold);
+
+/* That threshold for a CPU whose last-level cache holds llc bytes (0:
+ * unknown): the larger of RC__LARGE_MESH_BYTES and llc / 8. Measured on a
+ * Xeon VM with a 260 MB L3 (docs/benchmarks.md): turns cost 4% at 1k
+ * triangles and 11-15% for packets at 100k-300k (3.7-11 MB, all in cache),
+ * break even for packets and gain 40% for single rays at 1M (37 MB), and
+ * gain 47-88% at 10M. 8 MiB is above the last cache level of the ARM boards
+ * this is for (2-4 MB), where a 1M map already waits on DRAM. */
 #define RC__LARGE_MESH_BYTES (8u << 20)
-int rc__mesh_is_large(const rc__mesh *mesh);
+uint64_t rc__large_mesh_threshold(uint64_t llc);
 
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);

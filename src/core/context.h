@@ -28,6 +28,9 @@ struct rc_context {
     rc__pool *pool;
     uint32_t thread_count;
     uint32_t reserved0;
+    /* The built-in backend's traversals take turns in meshes larger than this
+     * (rc__large_mesh_threshold of the CPU's last-level cache). */
+    uint64_t large_mesh_bytes;
     rc_log_fn log;
     void *log_user;
     struct rc_scene *scenes;        /* singly linked, newest first */
