@@ -2,7 +2,9 @@
  * bvh/wide.h), traversed on the CPU by the
  * context's thread pool. Rays of a scan are traced in tiles (neighbouring rows
  * and columns of a grid sensor, or runs of consecutive O1Dn rays) that share
- * the sensor's origin, so the packet traversal serves a tile per node fetch.
+ * the sensor's origin, so the packet traversal serves a tile per node fetch
+ * (mesh by mesh in scenes of up to RC__PACKET_MAX_MESHES meshes and no
+ * instances; other scenes go ray by ray through the scene's top-level tree).
  * Work is split into tasks of one pose, or of a slice of a pose's tiles when
  * there are fewer poses than threads can keep busy. Each ray's answer depends
  * only on the ray (the packet changes the order of work, not the result), so
@@ -15,6 +17,11 @@
 #include <string.h>
 
 #define MIN_TILES_PER_TASK 64u
+/* Most meshes a scene may have for packets to test each one per tile: with
+ * more, the per-mesh root tests cost more than the packets save (a 100k VLP-16
+ * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
+ * 16 +30%, 32 +13%, 64 even, 128 -18%). */
+#define RC__PACKET_MAX_MESHES 32u
 
 typedef struct tiling {
     uint32_t tile_rows, tile_cols;   /* rays a tile spans */
@@ -30,6 +37,7 @@ typedef struct sim_run {
     int packets;                     /* 1 when tiles go through the packet traversal */
     uint32_t in_flight;              /* tiles traced at once (rc__mesh_packets_in_flight) */
     int rays_in_turns;               /* 1 when single rays of one large mesh take turns */
+    uint64_t large_bytes;            /* the context's rc__mesh_is_large threshold */
 } sim_run;
 
 /* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
@@ -89,6 +97,48 @@ static void hit_reset(rc__hit *hit, float tmax)
     hit->prim = hit->geom = hit->inst = hit->slot = RC_INVALID_ID;
 }
 
+/* A group of tiles through the scene. One-origin sensors on scenes without
+ * instances go in packets, mesh by mesh (each mesh's traversal starts from
+ * the nearest hit so far, and the tie rule makes the order of meshes
+ * irrelevant); the packets of a large mesh take turns. Other rays go one by
+ * one: OnDn rays of a single large mesh taking turns, the rest through both
+ * levels of the scene. */
+static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t group,
+                        rc__ray (*rays)[RC__PACKET_SIZE], const uint32_t *n, rc__hit (*hits)[RC__PACKET_SIZE],
+                        int (*found)[RC__PACKET_SIZE])
+{
+    uint32_t g, k, i;
+    if (run->packets) {
+        const rc__ray *prays[RC__PACKETS_IN_FLIGHT];
+        rc__hit *phits[RC__PACKETS_IN_FLIGHT];
+        int *pfound[RC__PACKETS_IN_FLIGHT];
+        for (k = 0; k < group; ++k) {
+            prays[k] = rays[k];
+            phits[k] = hits[k];
+            pfound[k] = found[k];
+        }
+        for (g = 0; g < scene->geom_count; ++g) {
+            const rc__mesh *mesh = &scene->geoms[g].mesh;
+            if (group > 1 && rc__mesh_is_large(mesh, run->large_bytes)) {
+                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound);
+            } else {
+                for (k = 0; k < group; ++k) rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k]);
+            }
+        }
+    } else if (run->rays_in_turns) {
+        /* full tiles lie back to back: one run keeps the turns full */
+        uint32_t full = 0;
+        while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
+        rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[0], full * RC__PACKET_SIZE + n[full], 0, RC_INVALID_ID,
+                                hits[0], found[0]);
+        for (k = full + 1; k < group; ++k)
+            rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[k], n[k], 0, RC_INVALID_ID, hits[k], found[k]);
+    } else {
+        for (k = 0; k < group; ++k)
+            for (i = 0; i < n[k]; ++i) found[k][i] = rc__scene_intersect(scene, &rays[k][i], &hits[k][i]);
+    }
+}
+
 static void trace_task(void *user, uint32_t task, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
@@ -111,9 +161,6 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
         rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
         rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
         int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
-        const rc__ray *prays[RC__PACKETS_IN_FLIGHT];
-        rc__hit *phits[RC__PACKETS_IN_FLIGHT];
-        int *pfound[RC__PACKETS_IN_FLIGHT];
         uint32_t n[RC__PACKETS_IN_FLIGHT], group = last - tile < run->in_flight ? last - tile : run->in_flight;
         uint32_t k, a, b, i;
         for (k = 0; k < group; ++k) {
@@ -128,24 +175,8 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
                 hit_reset(&hits[k][i], sensor->range_max);
                 found[k][i] = 0;
             }
-            prays[k] = rays[k];
-            phits[k] = hits[k];
-            pfound[k] = found[k];
         }
-        if (run->packets) {
-            rc__mesh_intersect_packets(&scene->geoms[0].mesh, group, prays, n, 0, RC_INVALID_ID, phits, pfound);
-        } else if (run->rays_in_turns) {
-            /* full tiles lie back to back: one run keeps the turns full */
-            uint32_t full = 0;
-            while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
-            rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[0], full * RC__PACKET_SIZE + n[full], 0,
-                                    RC_INVALID_ID, hits[0], found[0]);
-            for (k = full + 1; k < group; ++k)
-                rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[k], n[k], 0, RC_INVALID_ID, hits[k], found[k]);
-        } else {
-            for (k = 0; k < group; ++k)
-                for (i = 0; i < n[k]; ++i) found[k][i] = rc__scene_intersect(scene, &rays[k][i], &hits[k][i]);
-        }
+        trace_group(run, scene, group, rays, n, hits, found);
         for (k = 0; k < group; ++k)
             for (i = 0; i < n[k]; ++i) {
                 const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
@@ -164,18 +195,26 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     run.job = job;
     choose_tiling(s, &run.tl);
     run.tiles = run.tl.grid_rows * run.tl.grid_cols;
-    /* Packets need one shared origin and one mesh (the common map); other
-     * scenes go ray by ray through both levels. */
-    run.packets = s->origins == NULL && job->scene->geom_count == 1 && job->scene->inst_count == 0;
+    /* Packets need one shared origin and no instances; a scene of many meshes
+     * goes ray by ray through its top-level tree instead of testing every
+     * mesh's root per tile. */
+    run.packets = s->origins == NULL && job->scene->inst_count == 0 && job->scene->geom_count >= 1 &&
+                  job->scene->geom_count <= RC__PACKET_MAX_MESHES;
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif
-    {
-        const int one_mesh = job->scene->geom_count == 1 && job->scene->inst_count == 0;
-        const rc__mesh *mesh = one_mesh ? &job->scene->geoms[0].mesh : NULL;
-        run.in_flight = run.packets ? rc__mesh_packets_in_flight(mesh, ctx->large_mesh_bytes) : 1u;
-        run.rays_in_turns = !run.packets && one_mesh && rc__mesh_is_large(mesh, ctx->large_mesh_bytes);
-        if (run.rays_in_turns) run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
+    run.large_bytes = ctx->large_mesh_bytes;
+    run.in_flight = 1u;
+    if (run.packets) {
+        uint32_t g;
+        for (g = 0; g < job->scene->geom_count; ++g) {
+            const uint32_t f = rc__mesh_packets_in_flight(&job->scene->geoms[g].mesh, run.large_bytes);
+            run.in_flight = f > run.in_flight ? f : run.in_flight;
+        }
+    } else if (job->scene->geom_count == 1 && job->scene->inst_count == 0 &&
+               rc__mesh_is_large(&job->scene->geoms[0].mesh, run.large_bytes)) {
+        run.rays_in_turns = 1;
+        run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
     }
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */

@@ -1,0 +1,175 @@
+/* The built-in backend's ways through rc_simulate against the plain
+ * single-ray search of the whole scene (rc__scene_intersect): packets mesh by
+ * mesh on a scene of several meshes (duplicate meshes make every hit on them
+ * a tie the lower geometry id must win), packets and OnDn single rays taking
+ * turns on a map above the large-mesh threshold, each on 1 and 2 threads,
+ * two poses, partial tile groups. Every ray must report the same triangle and
+ * geometry. (test_packet.c and test_wide.c check the traversals bit for bit;
+ * this checks the backend's grouping of tiles and meshes around them.) The
+ * context's threshold is set by the test, whatever this CPU's cache. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh/packet.h"
+#include "core/context.h"
+#include "poses.h"
+#include "rc_test.h"
+#include "scene/scene.h"
+#include "sensor/sensor.h"
+
+#define RANGE_MIN 1e-4f
+#define RANGE_MAX 200.0f
+#define POSES 2u
+
+static rcu_rng rng;
+static double uniform(void) { return rcu_rng_uniform(&rng); }
+
+/* What the plain search finds for ray i of the sensor at pose (identity
+ * rotation: the world ray is the sensor ray moved by p): the hit's triangle
+ * (returned) and geometry, or RC_INVALID_ID twice (also for a surface nearer
+ * than range_min, which reads as no valid return). */
+static uint32_t expected_prim(const rc_scene *scene, const rc_sensor *s, uint32_t i, const rc_pose *p, uint32_t *geom)
+{
+    float org[3], dir[3];
+    rc__ray r;
+    rc__hit h;
+    uint32_t k;
+    for (k = 0; k < 3; ++k) {
+        org[k] = (s->origins ? s->origins[3u * i + k] : 0.0f) + p->position[k];
+        dir[k] = s->directions[3u * i + k];
+    }
+    rc__ray_prepare(&r, org, dir);
+    h.t = RANGE_MAX;
+    h.u = h.v = 0.0f;
+    h.prim = h.geom = h.inst = h.slot = RC_INVALID_ID;
+    if (!rc__scene_intersect(scene, &r, &h) || h.t < RANGE_MIN) {
+        *geom = RC_INVALID_ID;
+        return RC_INVALID_ID;
+    }
+    *geom = h.geom;
+    return h.prim;
+}
+
+static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sensor, uint32_t rays)
+{
+    rc_pose poses[POSES];
+    rct_buffers buf;
+    uint32_t p, i, hits = 0, box_hits = 0;
+    poses[0] = rct_pose(0.0f, 0.0f, 0.0f);
+    poses[1] = rct_pose(3.0f, -2.0f, 1.0f);
+    rct_buffers_alloc(&buf, (uint64_t)POSES * rays, RC_ATTR_HITS | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS);
+    RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, POSES, &buf.res));
+    for (p = 0; p < POSES; ++p)
+        for (i = 0; i < rays; ++i) {
+            const uint64_t at = (uint64_t)p * rays + i;
+            uint32_t want_geom;
+            const uint32_t want = expected_prim(scene, sensor, i, &poses[p], &want_geom);
+            assert_int_equal(buf.res.prim_ids[at], want);
+            assert_int_equal(buf.res.geom_ids[at], want_geom);
+            assert_int_equal(buf.res.hits[at], want != RC_INVALID_ID);
+            hits += buf.res.hits[at];
+            box_hits += want_geom == 1u;
+        }
+    /* every origin is inside the closed sphere (an OnDn origin may sit just
+     * on a box); with the boxes in the scene, some rays end on them (on
+     * geometry 1, never on its duplicate) */
+    assert_true(hits + 2u >= POSES * rays);
+    if (scene->geom_count > 1) assert_true(box_hits > 0);
+    rct_buffers_free(&buf);
+}
+
+/* A scene of the sphere and, with boxes set, a box (geometry 1) and the
+ * same box again (geometry 2), all referenced. */
+static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes)
+{
+    const rcu_mesh *parts[3];
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_scene *scene = NULL;
+    uint32_t g, id;
+    parts[0] = sphere;
+    parts[1] = parts[2] = box;
+    sd.max_geometries = boxes ? 3u : 1u;
+    sd.max_triangles = sphere->triangle_count + (boxes ? 2u * box->triangle_count : 0u);
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    for (g = 0; g < sd.max_geometries; ++g) {
+        rc_mesh_desc md = rc_mesh_desc_default();
+        md.vertices = parts[g]->vertices;
+        md.vertex_count = parts[g]->vertex_count;
+        md.indices = parts[g]->indices;
+        md.triangle_count = parts[g]->triangle_count;
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+        assert_int_equal(id, g);
+    }
+    RCT_OK(ctx, rc_scene_commit(scene));
+    return scene;
+}
+
+static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,
+                      const float *dirs, const float *orgs, uint32_t rays)
+{
+    uint32_t threads;
+    for (threads = 1; threads <= 2; ++threads) {
+        rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 128);
+        rc_scene *scene;
+        rc_rays_desc d = rc_rays_desc_default();
+        rc_sensor *o1dn, *ondn = NULL;
+        assert_true(ctx->large_mesh_bytes >= RC__LARGE_MESH_BYTES);
+        ctx->large_mesh_bytes = large_bytes;
+        scene = make_scene(ctx, sphere, box, boxes);
+        assert_int_equal(rc__mesh_is_large(&scene->geoms[0].mesh, large_bytes), large_bytes == RC__LARGE_MESH_BYTES);
+        o1dn = rct_sensor_dirs(ctx, dirs, rays, RANGE_MIN, RANGE_MAX);
+        d.common.range_min = RANGE_MIN;
+        d.common.range_max = RANGE_MAX;
+        d.directions = dirs;
+        d.origins = orgs;
+        d.ray_count = rays;
+        RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &ondn));
+        check_sensor(ctx, scene, o1dn, rays);
+        check_sensor(ctx, scene, ondn, rays);
+        rc_sensor_destroy(o1dn);
+        rc_sensor_destroy(ondn);
+        rc_context_destroy(ctx);
+    }
+}
+
+static void test_simulate_paths(void **state)
+{
+    /* 1,000 + 3 rays: 62 full tiles of 16 and a partial one, so groups of
+     * eight end short */
+    const uint32_t rays = 1003u;
+    const float lo[3] = {2.0f, -3.0f, -2.0f}, hi[3] = {6.0f, 3.0f, 2.0f};
+    float *dirs = (float *)malloc(sizeof(float) * 3u * rays), *orgs = (float *)malloc(sizeof(float) * 3u * rays);
+    rcu_mesh sphere, box;
+    uint32_t i, k;
+    (void)state;
+    assert_non_null(dirs);
+    assert_non_null(orgs);
+    /* 2 x 560 x 280 = 313,600 triangles: above the threshold's floor */
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 560, 280, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    for (i = 0; i < rays; ++i) {
+        /* a sweep in scan order (coherent runs for packets) and random
+         * origins within 5 m for OnDn */
+        const double yaw = 6.283185307 * i / rays, pitch = 0.4 * sin(0.37 * i);
+        dirs[3 * i] = (float)(cos(pitch) * cos(yaw));
+        dirs[3 * i + 1] = (float)(cos(pitch) * sin(yaw));
+        dirs[3 * i + 2] = (float)sin(pitch);
+        for (k = 0; k < 3; ++k) orgs[3 * i + k] = (float)((uniform() - 0.5) * 10.0);
+    }
+    /* turns (the floor makes the sphere large), then plain packets */
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 0, dirs, orgs, rays);
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 1, dirs, orgs, rays);
+    run_paths(&sphere, &box, UINT64_MAX, 1, dirs, orgs, rays);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+    free(dirs);
+    free(orgs);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_simulate_paths)};
+    rcu_rng_seed(&rng, 0x2545F4914F6CDD1Dull);
+    return cmocka_run_group_tests_name("simulate paths", tests, NULL, NULL);
+}
