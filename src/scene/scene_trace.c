@@ -2,6 +2,8 @@
  * and instances, then each mesh's BVH (instances in their own frame). */
 #include "scene/scene.h"
 
+#include "bvh/intersect.h"
+
 #include <math.h>
 
 /* Slab test against a top-level node. Top-level boxes are few, so this is not
@@ -21,9 +23,11 @@ static int box_hit(const rc__ray *r, const float bmin[3], const float bmax[3], f
         if (lo > t0) t0 = lo;
         if (hi < t1) t1 = hi;
     }
-    /* a small relative margin keeps boxes of flat meshes from being missed */
+    /* Ize's bound, as in the mesh trees: rounding never rejects a box the ray
+     * meets (a smaller margin could cull a mesh that a grazing ray hits, and
+     * the packet path, which tests every mesh, would then disagree) */
     *tnear = t0;
-    return t0 <= t1 * 1.0000002f;
+    return t0 <= t1 * RC__SLAB_FAR_SCALE;
 }
 
 static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc__ray *ray, rc__hit *hit)
