@@ -36,7 +36,7 @@ typedef struct sim_run {
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
     uint32_t in_flight;              /* tiles traced at once (rc__mesh_packets_in_flight) */
-    int rays_in_turns;               /* 1 when single rays of one large mesh take turns */
+    int rays_by_mesh;                /* 1 when single rays go mesh by mesh, taking turns in large ones */
     uint64_t large_bytes;            /* the context's rc__mesh_is_large threshold */
 } sim_run;
 
@@ -101,8 +101,8 @@ static void hit_reset(rc__hit *hit, float tmax)
  * instances go in packets, mesh by mesh (each mesh's traversal starts from
  * the nearest hit so far, and the tie rule makes the order of meshes
  * irrelevant); the packets of a large mesh take turns. Other rays go one by
- * one: OnDn rays of a single large mesh taking turns, the rest through both
- * levels of the scene. */
+ * one: mesh by mesh too when the scene has a large mesh to take turns in,
+ * else through both levels of the scene. */
 static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t group,
                         rc__ray (*rays)[RC__PACKET_SIZE], const uint32_t *n, rc__hit (*hits)[RC__PACKET_SIZE],
                         int (*found)[RC__PACKET_SIZE])
@@ -125,14 +125,22 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
                 for (k = 0; k < group; ++k) rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k]);
             }
         }
-    } else if (run->rays_in_turns) {
-        /* full tiles lie back to back: one run keeps the turns full */
-        uint32_t full = 0;
-        while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
-        rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[0], full * RC__PACKET_SIZE + n[full], 0, RC_INVALID_ID,
-                                hits[0], found[0]);
-        for (k = full + 1; k < group; ++k)
-            rc__mesh_intersect_rays(&scene->geoms[0].mesh, rays[k], n[k], 0, RC_INVALID_ID, hits[k], found[k]);
+    } else if (run->rays_by_mesh) {
+        for (g = 0; g < scene->geom_count; ++g) {
+            const rc__mesh *mesh = &scene->geoms[g].mesh;
+            if (rc__mesh_is_large(mesh, run->large_bytes)) {
+                /* full tiles lie back to back: one run keeps the turns full */
+                uint32_t full = 0;
+                while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
+                rc__mesh_intersect_rays(mesh, rays[0], full * RC__PACKET_SIZE + n[full], g, RC_INVALID_ID, hits[0],
+                                        found[0]);
+                for (k = full + 1; k < group; ++k)
+                    rc__mesh_intersect_rays(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k]);
+            } else {
+                for (k = 0; k < group; ++k)
+                    for (i = 0; i < n[k]; ++i) found[k][i] |= rc__mesh_intersect(mesh, &rays[k][i], g, RC_INVALID_ID, &hits[k][i]);
+            }
+        }
     } else {
         for (k = 0; k < group; ++k)
             for (i = 0; i < n[k]; ++i) found[k][i] = rc__scene_intersect(scene, &rays[k][i], &hits[k][i]);
@@ -211,10 +219,12 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
             const uint32_t f = rc__mesh_packets_in_flight(&job->scene->geoms[g].mesh, run.large_bytes);
             run.in_flight = f > run.in_flight ? f : run.in_flight;
         }
-    } else if (job->scene->geom_count == 1 && job->scene->inst_count == 0 &&
-               rc__mesh_is_large(&job->scene->geoms[0].mesh, run.large_bytes)) {
-        run.rays_in_turns = 1;
-        run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
+    } else if (job->scene->inst_count == 0 && job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
+        /* single rays (OnDn) go mesh by mesh when a large mesh lets them take turns */
+        uint32_t g;
+        for (g = 0; g < job->scene->geom_count; ++g)
+            if (rc__mesh_is_large(&job->scene->geoms[g].mesh, run.large_bytes)) run.rays_by_mesh = 1;
+        if (run.rays_by_mesh) run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
     }
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */

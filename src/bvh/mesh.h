@@ -69,8 +69,9 @@ int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t g
                             rc__hit *hit);
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 
-/* rays[0..n) one by one as rc__mesh_intersect would (found[i] = its
- * result), but up to RC__RAYS_IN_FLIGHT of them taking turns node by node,
+/* rays[0..n) one by one as rc__mesh_intersect would (found[i] |= its
+ * result: found[] is not cleared, so a scene's meshes can be searched in
+ * turn), but up to RC__RAYS_IN_FLIGHT of them taking turns node by node,
  * so that one ray's memory fetches overlap the others' work: for maps larger
  * than the caches (rc__mesh_is_large). */
 #define RC__RAYS_IN_FLIGHT 8u

@@ -337,7 +337,7 @@ void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t
     uint32_t slot_ray[RC__RAYS_IN_FLIGHT];
     uint32_t next = 0, live = 0, k;
     if (mesh->wide == NULL || mesh->wide_count == 0) {
-        for (k = 0; k < n; ++k) found[k] = rc__mesh_intersect(mesh, &rays[k], geom, inst, &hits[k]);
+        for (k = 0; k < n; ++k) found[k] |= rc__mesh_intersect(mesh, &rays[k], geom, inst, &hits[k]);
         return;
     }
     /* a slot whose ray is done takes the next one, so the turns stay full */
@@ -349,7 +349,7 @@ void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t
     while (live) {
         for (k = 0; k < RC__RAYS_IN_FLIGHT; ++k) {
             if (!((live >> k) & 1u) || turns_step(&T[k], mesh, geom, inst)) continue;
-            found[slot_ray[k]] = T[k].found;
+            found[slot_ray[k]] |= T[k].found;
             if (next < n) {
                 turns_start(&T[k], &rays[next], &hits[next]);
                 slot_ray[k] = next++;
