@@ -146,7 +146,7 @@ static void test_packets_in_turns_equal_single(void **state)
 
 /* Turns start above the threshold: RC__LARGE_MESH_BYTES, or an eighth of a
  * large last-level cache. */
-static void test_packets_in_flight_by_size(void **state)
+static void test_large_mesh_threshold(void **state)
 {
     rc__mesh m;
     (void)state;
@@ -155,12 +155,12 @@ static void test_packets_in_flight_by_size(void **state)
     m.triangle_count = 1000;
     m.vertex_count = 500;
     m.wide_count = 100;
-    assert_int_equal(rc__mesh_packets_in_flight(&m, RC__LARGE_MESH_BYTES), 1);
+    assert_int_equal(rc__mesh_is_large(&m, RC__LARGE_MESH_BYTES), 0);
     m.triangle_count = 10000000;
     m.vertex_count = 5000000;
     m.wide_count = 1000000;
-    assert_int_equal(rc__mesh_packets_in_flight(&m, RC__LARGE_MESH_BYTES), RC__PACKETS_IN_FLIGHT);
-    assert_int_equal(rc__mesh_packets_in_flight(&m, (uint64_t)1 << 30), 1);
+    assert_int_equal(rc__mesh_is_large(&m, RC__LARGE_MESH_BYTES), 1);
+    assert_int_equal(rc__mesh_is_large(&m, (uint64_t)1 << 30), 0);
     assert_true(rc__large_mesh_threshold(0) == RC__LARGE_MESH_BYTES);
     assert_true(rc__large_mesh_threshold(2u << 20) == RC__LARGE_MESH_BYTES);
     assert_true(rc__large_mesh_threshold((uint64_t)260 << 20) == (uint64_t)260 << 17);
@@ -170,6 +170,6 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single),
                                        cmocka_unit_test(test_packets_in_turns_equal_single),
-                                       cmocka_unit_test(test_packets_in_flight_by_size)};
+                                       cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

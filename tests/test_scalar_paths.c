@@ -11,11 +11,9 @@
 #undef rc__mesh_intersect_rays
 #define rc__mesh_intersect_packet scalar_intersect_packet
 #define rc__mesh_intersect_packets scalar_intersect_packets
-#define rc__mesh_packets_in_flight scalar_packets_in_flight
 #include "../src/bvh/packet.c"
 #undef rc__mesh_intersect_packet
 #undef rc__mesh_intersect_packets
-#undef rc__mesh_packets_in_flight
 #undef rc__mesh_intersect_wide
 #undef rc__mesh_occluded_wide
 

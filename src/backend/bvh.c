@@ -22,6 +22,8 @@
  * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
  * 16 +30%, 32 +13%, 64 even, 128 -18%). */
 #define RC__PACKET_MAX_MESHES 32u
+/* sim_run.large holds one bit per mesh */
+typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
 
 typedef struct tiling {
     uint32_t tile_rows, tile_cols;   /* rays a tile spans */
@@ -35,9 +37,10 @@ typedef struct sim_run {
     uint32_t slices;                 /* tasks per pose */
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
-    uint32_t in_flight;              /* tiles traced at once (rc__mesh_packets_in_flight) */
+    uint32_t in_flight;              /* tiles traced at once: RC__PACKETS_IN_FLIGHT with a large mesh, else 1 */
     int rays_by_mesh;                /* 1 when single rays go mesh by mesh, taking turns in large ones */
-    uint64_t large_bytes;            /* the context's rc__mesh_is_large threshold */
+    uint32_t large;                  /* bit g: mesh g is large (rc__mesh_is_large), for scenes of
+                                      * up to RC__PACKET_MAX_MESHES meshes */
 } sim_run;
 
 /* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
@@ -119,7 +122,7 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         }
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
-            if (group > 1 && rc__mesh_is_large(mesh, run->large_bytes)) {
+            if (group > 1 && ((run->large >> g) & 1u)) {
                 rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound);
             } else {
                 for (k = 0; k < group; ++k) rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k]);
@@ -128,7 +131,7 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
     } else if (run->rays_by_mesh) {
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
-            if (rc__mesh_is_large(mesh, run->large_bytes)) {
+            if ((run->large >> g) & 1u) {
                 /* full tiles lie back to back: one run keeps the turns full */
                 uint32_t full = 0;
                 while (full + 1 < group && n[full] == RC__PACKET_SIZE) ++full;
@@ -211,21 +214,15 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif
-    run.large_bytes = ctx->large_mesh_bytes;
-    run.in_flight = 1u;
-    if (run.packets) {
-        uint32_t g;
-        for (g = 0; g < job->scene->geom_count; ++g) {
-            const uint32_t f = rc__mesh_packets_in_flight(&job->scene->geoms[g].mesh, run.large_bytes);
-            run.in_flight = f > run.in_flight ? f : run.in_flight;
-        }
-    } else if (job->scene->inst_count == 0 && job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
-        /* single rays (OnDn) go mesh by mesh when a large mesh lets them take turns */
+    if (job->scene->inst_count == 0 && job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
         uint32_t g;
         for (g = 0; g < job->scene->geom_count; ++g)
-            if (rc__mesh_is_large(&job->scene->geoms[g].mesh, run.large_bytes)) run.rays_by_mesh = 1;
-        if (run.rays_by_mesh) run.in_flight = RC__PACKETS_IN_FLIGHT; /* 128 rays a run */
+            if (rc__mesh_is_large(&job->scene->geoms[g].mesh, ctx->large_mesh_bytes)) run.large |= 1u << g;
     }
+    /* packets of a large mesh take turns; single rays (OnDn) go mesh by mesh
+     * when a large mesh lets them take turns, 128 rays a run */
+    run.rays_by_mesh = !run.packets && run.large != 0;
+    run.in_flight = run.large ? RC__PACKETS_IN_FLIGHT : 1u;
     run.slices = 1;
     /* Few poses: cut each scan into slices so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {

@@ -467,8 +467,3 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
             if (((live >> k) & 1u) && !trav_step(&T[k], mesh, geom, inst, 1)) live &= ~(1u << k);
     }
 }
-
-uint32_t rc__mesh_packets_in_flight(const rc__mesh *mesh, uint64_t large_bytes)
-{
-    return rc__mesh_is_large(mesh, large_bytes) ? RC__PACKETS_IN_FLIGHT : 1u;
-}

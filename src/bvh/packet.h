@@ -27,8 +27,4 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
                                 int *const *found);
 
-/* How many packets to trace at once in this mesh: RC__PACKETS_IN_FLIGHT in a
- * large one (rc__mesh_is_large with this threshold), else 1 (no turns). */
-uint32_t rc__mesh_packets_in_flight(const rc__mesh *mesh, uint64_t large_bytes);
-
 #endif

@@ -26,23 +26,16 @@ static uint64_t parse_size(const char *s, long n)
 
 uint64_t rc__last_level_cache_bytes(void)
 {
-    static const char prefix[] = "/sys/devices/system/cpu/cpu0/cache/index";
+    char path[] = "/sys/devices/system/cpu/cpu0/cache/index0/size";
+    const size_t digit = sizeof "/sys/devices/system/cpu/cpu0/cache/index" - 1;
     uint64_t best = 0;
-    char path[sizeof prefix + 8];
-    unsigned i, k;
-    for (k = 0; k < sizeof prefix - 1; ++k) path[k] = prefix[k];
+    unsigned i;
     for (i = 0; i < 8; ++i) {
         char text[32];
         long got;
-        int fd;
         uint64_t v;
-        path[k] = (char)('0' + i);
-        path[k + 1] = '/';
-        path[k + 2] = 's';
-        path[k + 3] = 'i';
-        path[k + 4] = 'z';
-        path[k + 5] = 'e';
-        path[k + 6] = '\0';
+        int fd;
+        path[digit] = (char)('0' + i);
         fd = open(path, O_RDONLY);
         if (fd < 0) continue;
         got = (long)read(fd, text, sizeof text);
