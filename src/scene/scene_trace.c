@@ -106,23 +106,46 @@ void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3])
     }
 }
 
+/* The mesh of a hit and its instance transform (NULL without one). */
+static const rc__mesh *hit_mesh(const rc_scene *scene, const rc__hit *hit, const rc__xformf **x)
+{
+    if (hit->inst == RC_INVALID_ID) {
+        *x = NULL;
+        return &scene->geoms[hit->geom].mesh;
+    }
+    *x = &scene->insts[hit->inst].to_world;
+    return &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
+}
+
+/* The hit triangle's vertex indices: the leaf-ordered copy was just read by
+ * the built-in triangle test (cached); the mesh's own index array is a miss on
+ * a large map. */
+static const uint32_t *hit_triangle(const rc__mesh *mesh, const rc__hit *hit)
+{
+    return hit->slot != RC_INVALID_ID && mesh->leaf_tris ? mesh->leaf_tris + (size_t)3 * hit->slot
+                                                         : mesh->indices + (size_t)3 * hit->prim;
+}
+
+void rc__scene_hit_prefetch(const rc_scene *scene, const rc__hit *hit, int stage)
+{
+    const rc__xformf *x;
+    const rc__mesh *mesh = hit_mesh(scene, hit, &x);
+    const uint32_t *tri = hit_triangle(mesh, hit);
+    int i;
+    if (stage == 0) {
+        RC__PREFETCH(tri);
+        return;
+    }
+    for (i = 0; i < 3; ++i) RC__PREFETCH(mesh->vertices + (size_t)tri[i] * mesh->stride);
+}
+
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const double org[3], const double dir[3])
 {
-    const rc__mesh *mesh;
-    const rc__xformf *x = NULL;
-    const uint32_t *tri;
+    const rc__xformf *x;
+    const rc__mesh *mesh = hit_mesh(scene, hit, &x);
+    const uint32_t *tri = hit_triangle(mesh, hit);
     double v[3][3], e1[3], e2[3], n[3], dn, w;
     int i, k;
-    if (hit->inst == RC_INVALID_ID) {
-        mesh = &scene->geoms[hit->geom].mesh;
-    } else {
-        x = &scene->insts[hit->inst].to_world;
-        mesh = &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
-    }
-    /* the leaf-ordered copy was just read by the triangle test (cached); the
-     * mesh's own index array is a miss on a large map */
-    tri = hit->slot != RC_INVALID_ID && mesh->leaf_tris ? mesh->leaf_tris + (size_t)3 * hit->slot
-                                                        : mesh->indices + (size_t)3 * hit->prim;
     for (i = 0; i < 3; ++i) {
         const float *p = mesh->vertices + (size_t)tri[i] * mesh->stride;
         if (x) {
