@@ -6,7 +6,8 @@
  * 16-byte vertex stride (shared in place), and two scaled, rotated instances
  * of a unit box scene. Rays: 4096 random rays from random origins (OnDn: runs
  * of consecutive rays make the packets) and a VLP-16 (tiles of its grid), two
- * poses each, through every packet width (1, 4, 8, 16).
+ * poses each, through every packet width (1, 4, 8, 16), with the hits'
+ * triangles prefetched before the write (as on a large map) and without.
  *
  * Agreement: hit flags equal, except rays passing within 1e-6 (relative to
  * the range) of an edge of the triangle either backend hit; ranges within
@@ -340,15 +341,20 @@ static void test_parity(void **state)
     RCT_OK(cb, rc_simulate(cb, sb, lidar_b, lidar_poses, NPOSES, &ref_lidar.res));
 
     memset(&tl, 0, sizeof tl);
-    for (i = 0; i < sizeof widths / sizeof widths[0]; ++i) {
-        char what[64];
-        opt->packet_width = widths[i];
+    /* every width, with the hits' triangles prefetched (as on a large map:
+     * the threshold pinned to 0) and without */
+    for (i = 0; i < 2u * (sizeof widths / sizeof widths[0]); ++i) {
+        char what[96];
+        const char *pf = i % 2u ? "prefetched" : "not prefetched";
+        opt->packet_width = widths[i / 2u];
+        ce->large_mesh_bytes = i % 2u ? 0u : UINT64_MAX;
         rct_buffers_fill(&emb, 0xCD);
         RCT_OK(ce, rc_simulate(ce, se, rays_e, poses, NPOSES, &emb.res));
-        snprintf(what, sizeof what, "random rays, packet width %u", (unsigned)widths[i]);
+        snprintf(what, sizeof what, "random rays, packet width %u, %s", (unsigned)opt->packet_width, pf);
         compare(&w, rays_e, poses, NPOSES, &ref_rays, &emb, what, &tl);
+        rct_buffers_fill(&emb, 0xCD);
         RCT_OK(ce, rc_simulate(ce, se, lidar_e, lidar_poses, NPOSES, &emb.res));
-        snprintf(what, sizeof what, "VLP-16, packet width %u", (unsigned)widths[i]);
+        snprintf(what, sizeof what, "VLP-16, packet width %u, %s", (unsigned)opt->packet_width, pf);
         compare(&w, lidar_e, lidar_poses, NPOSES, &ref_lidar, &emb, what, &tl);
     }
     print_message("parity: %u elements compared, %u within %.0e of an edge (skipped), 0 mismatches\n",

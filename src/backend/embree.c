@@ -20,6 +20,7 @@
  *   different thread counts build with the smallest. Tracing runs on the
  *   context's own thread pool and is not affected. */
 #include "backend/embree_impl.h"
+#include "core/cache_size.h"
 
 #include <stdbool.h>
 #include <stdio.h>
@@ -231,6 +232,7 @@ static rc_status emb_init(rc_context *ctx, const rc_context_desc *desc)
         return st;
     }
     d->native_width = native_width(d->device);
+    ctx->large_mesh_bytes = rc__large_mesh_threshold(rc__last_level_cache_bytes());
     ctx->backend_data = d;
     return RC_OK;
 }

@@ -31,9 +31,12 @@
  *   arrays, which Embree's traversal never touches (it keeps its own copy),
  *   so on a large map each hit costs two dependent cache misses: its index
  *   triple, then its vertices. A batch prefetches every hit's triple as its
- *   packet returns and every hit's vertices before writing, so the misses of
- *   64 rays overlap instead of queueing one after another (1M-triangle
- *   sphere, VLP-16: the write took ~40% of the time before). */
+ *   packet returns and every hit's vertices a batch ahead of writing, so the
+ *   misses of 64 rays overlap instead of queueing one after another
+ *   (1M-triangle sphere, VLP-16: the write took ~40% of the time before).
+ *   Only on large scenes (Embree's bytes and the meshes' arrays above the
+ *   context's large_mesh_bytes): on small ones everything is in cache and the
+ *   prefetches were 11% more instructions for nothing (1k triangles). */
 #include "backend/embree_impl.h"
 
 #include <float.h>
@@ -54,6 +57,7 @@ typedef struct trace_run {
     uint32_t slices, tiles_per_slice;
     int coherent;
     int dups;                  /* some mesh the rays can reach has duplicate triangles */
+    int prefetch;              /* the scene is large: prefetch the hits' triangles */
     const float *directions;   /* the sensor's tables */
     const float *origins;
     float range_max;
@@ -124,7 +128,7 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t r, flo
             src = (const rc__emb_scene *)run->job->scene->insts[hit->inst].source->backend_scene;
         if (src->geoms[geom].dup_count) hit->prim = rc__emb_canonical_prim(&src->geoms[geom], prim);
     }
-    rc__scene_hit_prefetch(run->job->scene, hit, 0);
+    if (run->prefetch) rc__scene_hit_prefetch(run->job->scene, hit, 0);
 }
 
 /* Prefetches the vertices of every hit of a batch (their index triples were
@@ -132,6 +136,7 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t r, flo
 static void batch_prefetch(const trace_run *run, const hit_batch *b)
 {
     uint32_t i;
+    if (!run->prefetch) return;
     for (i = 0; i < b->count; ++i)
         if (b->found[i]) rc__scene_hit_prefetch(run->job->scene, &b->hit[i], 1);
 }
@@ -336,6 +341,23 @@ static int scene_has_dups(const rc_scene *scene)
     return 0;
 }
 
+/* Bytes of the meshes' own index and vertex arrays that the refinement reads,
+ * over every scene of the context (each once, like Embree's bytes: a scene
+ * that instances another reads both). */
+static uint64_t context_mesh_bytes(const rc_context *ctx)
+{
+    const rc_scene *scene;
+    uint64_t bytes = 0;
+    uint32_t g;
+    for (scene = ctx->scenes; scene; scene = scene->next)
+        for (g = 0; g < scene->geom_count; ++g) {
+            const rc__mesh *m = &scene->geoms[g].mesh;
+            bytes += (uint64_t)m->triangle_count * 3u * sizeof(uint32_t) +
+                     (uint64_t)m->vertex_count * m->stride * sizeof(float);
+        }
+    return bytes;
+}
+
 rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
 {
     const rc__emb_device *d = (const rc__emb_device *)ctx->backend_data;
@@ -354,6 +376,8 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
     run.origins = sensor->origins;
     run.range_max = sensor->range_max;
     run.dups = scene_has_dups(job->scene);
+    /* Embree's structures compete for the same cache */
+    run.prefetch = d->options.bytes_now + context_mesh_bytes(ctx) > ctx->large_mesh_bytes;
     run.width = pick_width(d);
     run.grid_rows = grid ? sensor->rows : 1u;
     run.grid_cols = grid ? sensor->columns : sensor->rays;

@@ -29,7 +29,8 @@ struct rc_context {
     uint32_t thread_count;
     uint32_t reserved0;
     /* The built-in backend's traversals take turns in meshes larger than this
-     * (rc__large_mesh_threshold of the CPU's last-level cache). */
+     * (rc__large_mesh_threshold of the CPU's last-level cache); the Embree
+     * backend prefetches its hits' triangles in scenes larger than this. */
     uint64_t large_mesh_bytes;
     rc_log_fn log;
     void *log_user;
