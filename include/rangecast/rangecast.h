@@ -204,11 +204,12 @@ RC_API rc_status rc_context_memory_requirements(const rc_context_desc *desc, siz
 
 /* Creates a context: checks the desc, sets up the arena (one malloc when no
  * block is given), starts thread_count - 1 worker threads, initialises the
- * backend. On Linux the built-in backend reads the CPU's cache sizes from
- * /sys/devices/system/cpu/cpu0/cache here (open and read, no allocation) to
- * decide which maps are large enough for its traversals to take turns;
- * where /sys is unreadable it assumes a small cache. *out is set only on
- * RC_OK.
+ * backend. On Linux the built-in and Embree backends read the CPU's cache
+ * sizes from /sys/devices/system/cpu/cpu0/cache here (open and read, no
+ * allocation) to decide which maps are large: the built-in backend's
+ * traversals take turns in those, the Embree backend prefetches its hits'
+ * triangles; where /sys is unreadable they assume a small cache. *out is set
+ * only on RC_OK.
  * Returns RC_ERR_INVALID_ARGUMENT, RC_ERR_STRUCT_SIZE, RC_ERR_OUT_OF_MEMORY
  * (block too small or malloc failed), RC_ERR_UNSUPPORTED (backend absent or no
  * device), RC_ERR_BACKEND. Thread-safe (it touches no shared state). */
