@@ -41,15 +41,7 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
     if (found) {
         /* float64 refinement of the distance along the ray (cheap: once per
          * hit): removes the float rounding of the traversal's t */
-        double od[3], dd[3], td;
-        int a;
-        for (a = 0; a < 3; ++a) {
-            dd[a] = world->rd[3 * a] * dir_s[0] + world->rd[3 * a + 1] * dir_s[1] + world->rd[3 * a + 2] * dir_s[2];
-            od[a] = world->td[a];
-            if (org_s)
-                od[a] += world->rd[3 * a] * org_s[0] + world->rd[3 * a + 1] * org_s[1] + world->rd[3 * a + 2] * org_s[2];
-        }
-        td = rc__scene_hit_distance_d(job->scene, hit, od, dd);
+        const double td = rc__scene_hit_distance_d(job->scene, hit, world, dir_s, org_s);
         /* the plane of the hit triangle in double is the better distance, also
          * for needles and slivers where the float test's t is coarse; a
          * non-positive value (origin on the plane) keeps the traversal's t */

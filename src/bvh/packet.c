@@ -212,12 +212,15 @@ static inline float lanes_tmax(const packet_lanes *L)
 #endif
 }
 
-static void packet_bounds_init(packet_bounds *P, const packet_lanes *L, uint32_t n)
+/* tmax: the largest of the lanes' (passed in: lanes_tmax would load the
+ * lanes as vectors right after trav_init stored them one by one, a failed
+ * store-to-load forward) */
+static void packet_bounds_init(packet_bounds *P, const packet_lanes *L, uint32_t n, float tmax)
 {
     const float *inv[3] = {L->ix, L->iy, L->iz};
     uint32_t i, k;
     P->usable = 1;
-    P->tmax = lanes_tmax(L);
+    P->tmax = tmax;
     for (k = 0; k < 3; ++k) {
         P->ilo[k] = P->ihi[k] = inv[k][0];
         for (i = 0; i < n; ++i) {
@@ -307,18 +310,21 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
                      int *found)
 {
     uint32_t i;
+    float tmax;
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
     if (!one_octant(rays, n, T->L.near_row)) return 0;
     for (i = 0; i < 3; ++i) T->L.org[i] = rays[0].org[i];
+    tmax = hits[0].t;
     for (i = 0; i < LANES; ++i) {
         const rc__ray *r = &rays[i < n ? i : 0];
         T->L.ix[i] = r->inv_dir[0];
         T->L.iy[i] = r->inv_dir[1];
         T->L.iz[i] = r->inv_dir[2];
         T->L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
+        if (i < n && hits[i].t > tmax) tmax = hits[i].t;
     }
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
-    packet_bounds_init(&T->P, &T->L, n);
+    packet_bounds_init(&T->P, &T->L, n, tmax);
     T->rays = rays;
     T->hits = hits;
     T->found = found;

@@ -75,11 +75,13 @@ int rc__scene_up_to_date(const rc_scene *scene);
  * Returns 1 when hit was updated. */
 int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit);
 
-/* The hit's distance recomputed in double: the ray (org + t dir, scene frame)
- * against the plane of the hit triangle (through its instance's transform in
- * double). Returns hit->t where the ray is parallel to the plane. */
-double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const double org[3],
-                                const double dir[3]);
+/* The hit's distance recomputed in double: the ray (sensor-frame direction
+ * dir_s and origin org_s, NULL for the sensor's own origin, through the
+ * scan's world transform in double) against the plane of the hit triangle
+ * (through its instance's transform in double). Returns hit->t where the ray
+ * is parallel to the plane. */
+double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
+                                const float dir_s[3], const float *org_s);
 
 /* Prefetches what rc__scene_hit_distance_d and rc__scene_hit_normal read for
  * a hit, in two stages: stage 0 its triangle's index triple, stage 1 its three
