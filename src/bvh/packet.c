@@ -190,6 +190,25 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
 #endif
 }
 
+/* L->tmax[lane] = t, written as the whole row of four lanes: the box tests
+ * load rows, and a row load right after a one-lane store cannot be
+ * forwarded from it (the load waits for the store to reach the cache). */
+static inline void lane_set_tmax(packet_lanes *L, uint32_t lane, float t)
+{
+#if defined(RC__PACKET_SSE2)
+    float *row = L->tmax + (lane & ~3u);
+    const __m128 sel = _mm_castsi128_ps(_mm_cmpeq_epi32(_mm_set1_epi32((int)(lane & 3u)), _mm_setr_epi32(0, 1, 2, 3)));
+    _mm_store_ps(row, _mm_or_ps(_mm_and_ps(sel, _mm_set1_ps(t)), _mm_andnot_ps(sel, _mm_load_ps(row))));
+#elif defined(RC__PACKET_NEON)
+    static const uint32_t slot[4] = {0u, 1u, 2u, 3u};
+    float *row = L->tmax + (lane & ~3u);
+    const uint32x4_t sel = vceqq_u32(vdupq_n_u32(lane & 3u), vld1q_u32(slot));
+    vst1q_f32(row, vbslq_f32(sel, vdupq_n_f32(t), vld1q_f32(row)));
+#else
+    L->tmax[lane] = t;
+#endif
+}
+
 /* Largest tmax over the lanes (unused lanes hold -1). */
 static inline float lanes_tmax(const packet_lanes *L)
 {
@@ -210,28 +229,6 @@ static inline float lanes_tmax(const packet_lanes *L)
     for (i = 1; i < LANES; ++i) m = L->tmax[i] > m ? L->tmax[i] : m;
     return m;
 #endif
-}
-
-/* tmax: the largest of the lanes' (passed in: lanes_tmax would load the
- * lanes as vectors right after trav_init stored them one by one, a failed
- * store-to-load forward) */
-static void packet_bounds_init(packet_bounds *P, const packet_lanes *L, uint32_t n, float tmax)
-{
-    const float *inv[3] = {L->ix, L->iy, L->iz};
-    uint32_t i, k;
-    P->usable = 1;
-    P->tmax = tmax;
-    for (k = 0; k < 3; ++k) {
-        P->ilo[k] = P->ihi[k] = inv[k][0];
-        for (i = 0; i < n; ++i) {
-            const float v = inv[k][i];
-            if (!(v > -FLT_MAX && v < FLT_MAX)) P->usable = 0; /* inf: the NaN cases of box_mask */
-            P->ilo[k] = v < P->ilo[k] ? v : P->ilo[k];
-            P->ihi[k] = v > P->ihi[k] ? v : P->ihi[k];
-        }
-    }
-    /* tmax beyond float range would make inf * 0 possible below */
-    if (!(P->tmax < FLT_MAX)) P->usable = 0;
 }
 
 /* 1 when every ray of the packet has the same direction signs (by the sign of
@@ -309,22 +306,46 @@ typedef struct packet_trav {
 static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
                      int *found)
 {
-    uint32_t i;
-    float tmax;
+    packet_bounds *P = &T->P;
+    packet_lanes *L = &T->L;
+    uint32_t i, k;
+    int finite = 1;
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
-    if (!one_octant(rays, n, T->L.near_row)) return 0;
-    for (i = 0; i < 3; ++i) T->L.org[i] = rays[0].org[i];
-    tmax = hits[0].t;
-    for (i = 0; i < LANES; ++i) {
-        const rc__ray *r = &rays[i < n ? i : 0];
-        T->L.ix[i] = r->inv_dir[0];
-        T->L.iy[i] = r->inv_dir[1];
-        T->L.iz[i] = r->inv_dir[2];
-        T->L.tmax[i] = i < n ? hits[i].t : -1.0f; /* unused lanes never hit */
-        if (i < n && hits[i].t > tmax) tmax = hits[i].t;
+    if (!one_octant(rays, n, L->near_row)) return 0;
+    for (k = 0; k < 3; ++k) {
+        L->org[k] = rays[0].org[k];
+        P->ilo[k] = P->ihi[k] = rays[0].inv_dir[k];
     }
+    /* the lanes, and in the same pass the packet's bounds: per axis the
+     * smallest and largest reciprocal, the largest tmax (taken here, not
+     * reloaded from the lanes: a row load right after one-lane stores would
+     * wait for them to reach the cache) */
+    P->tmax = hits[0].t;
+    for (i = 0; i < n; ++i) {
+        const float *inv = rays[i].inv_dir;
+        L->ix[i] = inv[0];
+        L->iy[i] = inv[1];
+        L->iz[i] = inv[2];
+        L->tmax[i] = hits[i].t;
+        P->tmax = hits[i].t > P->tmax ? hits[i].t : P->tmax;
+        for (k = 0; k < 3; ++k) {
+            P->ilo[k] = inv[k] < P->ilo[k] ? inv[k] : P->ilo[k];
+            P->ihi[k] = inv[k] > P->ihi[k] ? inv[k] : P->ihi[k];
+            finite &= inv[k] == inv[k];
+        }
+    }
+    for (; i < LANES; ++i) { /* unused lanes: lane 0's ray, never hits */
+        L->ix[i] = L->ix[0];
+        L->iy[i] = L->iy[0];
+        L->iz[i] = L->iz[0];
+        L->tmax[i] = -1.0f;
+    }
+    /* an infinite reciprocal (a zero direction component) gives box_mask's
+     * NaN cases, and a tmax beyond float range inf * 0: the interval test
+     * cannot bound those */
+    for (k = 0; k < 3; ++k) finite &= P->ilo[k] > -FLT_MAX && P->ihi[k] < FLT_MAX;
+    P->usable = finite && P->tmax < FLT_MAX;
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
-    packet_bounds_init(&T->P, &T->L, n, tmax);
     T->rays = rays;
     T->hits = hits;
     T->found = found;
@@ -406,7 +427,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
                 cand &= cand - 1u;
                 if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
                 if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
-                L->tmax[lane] = t;
+                lane_set_tmax(L, lane, t);
                 T->found[lane] = 1;
                 shrunk = 1;
             }
