@@ -14,6 +14,7 @@
 #include "bvh/leaf4.h"
 
 #include <float.h>
+#include <stddef.h>
 
 #if defined(__SSE2__) && !defined(RC__PACKET_FORCE_SCALAR)
 #include <emmintrin.h>
@@ -231,6 +232,7 @@ static inline float lanes_tmax(const packet_lanes *L)
 #endif
 }
 
+#if !defined(RC__PACKET_SSE2)
 /* 1 when every ray of the packet has the same direction signs (by the sign of
  * its reciprocal, so -0 counts as negative, as in the single-ray test). */
 static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_row[3])
@@ -244,6 +246,7 @@ static int one_octant(const rc__ray *rays, uint32_t n, uint32_t near_row[3])
     }
     return 1;
 }
+#endif
 
 static int octant_of(const rc__ray *r)
 {
@@ -301,25 +304,70 @@ typedef struct packet_trav {
     packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
 } packet_trav;
 
-/* Starts T on the root. 0 when the packet cannot run as one (empty, too
- * large, mixed octants, no tree): the caller takes the rays another way. */
-static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
-                     int *found)
+#if defined(RC__PACKET_SSE2)
+/* A ray's reciprocal is read as one 16-byte row (the int after it is the
+ * fourth lane, ignored) */
+typedef char rc__packet_ray_row_check[offsetof(rc__ray, inv_dir) + 4 * sizeof(float) <= sizeof(rc__ray) ? 1 : -1];
+#endif
+
+/* Fills L from the packet's rays and P with its bounds: per axis the
+ * smallest and largest reciprocal, and the largest tmax. 0 when the rays do
+ * not share one octant (L and P are then unusable). Lanes past n repeat ray 0
+ * and never hit (tmax -1).
+ * SSE2 takes four rays a row at a time, transposes them and stores whole
+ * rows: the box tests load rows, and a row load right after one-lane stores
+ * would wait for them to reach the cache. The bounds come from the same
+ * registers (a scalar pass over the lanes was 40 instructions a ray). */
+static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, uint32_t n, const rc__hit *hits)
 {
-    packet_bounds *P = &T->P;
-    packet_lanes *L = &T->L;
     uint32_t i, k;
     int finite = 1;
-    if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
+#if defined(RC__PACKET_SSE2)
+    const __m128 zero = _mm_setzero_ps();
+    const __m128 first = _mm_loadu_ps(rays[0].inv_dir);
+    const int neg = _mm_movemask_ps(_mm_cmplt_ps(first, zero)) & 7;
+    __m128 lo = first, hi = first, nan = _mm_cmpunord_ps(first, first), tm = _mm_set1_ps(hits[0].t);
+    float l4[4], h4[4], t4[4];
+    int mixed = 0;
+    for (i = 0; i < LANES; i += 4) {
+        __m128 r0 = _mm_loadu_ps(rays[i < n ? i : 0].inv_dir);
+        __m128 r1 = _mm_loadu_ps(rays[i + 1 < n ? i + 1 : 0].inv_dir);
+        __m128 r2 = _mm_loadu_ps(rays[i + 2 < n ? i + 2 : 0].inv_dir);
+        __m128 r3 = _mm_loadu_ps(rays[i + 3 < n ? i + 3 : 0].inv_dir);
+        const __m128 t = _mm_setr_ps(i < n ? hits[i].t : -1.0f, i + 1 < n ? hits[i + 1].t : -1.0f,
+                                     i + 2 < n ? hits[i + 2].t : -1.0f, i + 3 < n ? hits[i + 3].t : -1.0f);
+        /* direction signs by "< 0", as in the single-ray test */
+        mixed |= (_mm_movemask_ps(_mm_cmplt_ps(r0, zero)) ^ neg) | (_mm_movemask_ps(_mm_cmplt_ps(r1, zero)) ^ neg) |
+                 (_mm_movemask_ps(_mm_cmplt_ps(r2, zero)) ^ neg) | (_mm_movemask_ps(_mm_cmplt_ps(r3, zero)) ^ neg);
+        lo = _mm_min_ps(lo, _mm_min_ps(_mm_min_ps(r0, r1), _mm_min_ps(r2, r3)));
+        hi = _mm_max_ps(hi, _mm_max_ps(_mm_max_ps(r0, r1), _mm_max_ps(r2, r3)));
+        nan = _mm_or_ps(nan, _mm_or_ps(_mm_cmpunord_ps(r0, r1), _mm_cmpunord_ps(r2, r3)));
+        tm = _mm_max_ps(tm, t);
+        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+        _mm_store_ps(L->ix + i, r0);
+        _mm_store_ps(L->iy + i, r1);
+        _mm_store_ps(L->iz + i, r2);
+        _mm_store_ps(L->tmax + i, t);
+    }
+    if (mixed & 7) return 0;
+    _mm_storeu_ps(l4, lo);
+    _mm_storeu_ps(h4, hi);
+    _mm_storeu_ps(t4, tm);
+    finite = !(_mm_movemask_ps(nan) & 7);
+    P->tmax = t4[0];
+    for (k = 1; k < 4; ++k) P->tmax = t4[k] > P->tmax ? t4[k] : P->tmax;
+    for (k = 0; k < 3; ++k) {
+        L->near_row[k] = 2u * k + (uint32_t)((neg >> k) & 1);
+        L->org[k] = rays[0].org[k];
+        P->ilo[k] = l4[k];
+        P->ihi[k] = h4[k];
+    }
+#else
     if (!one_octant(rays, n, L->near_row)) return 0;
     for (k = 0; k < 3; ++k) {
         L->org[k] = rays[0].org[k];
         P->ilo[k] = P->ihi[k] = rays[0].inv_dir[k];
     }
-    /* the lanes, and in the same pass the packet's bounds: per axis the
-     * smallest and largest reciprocal, the largest tmax (taken here, not
-     * reloaded from the lanes: a row load right after one-lane stores would
-     * wait for them to reach the cache) */
     P->tmax = hits[0].t;
     for (i = 0; i < n; ++i) {
         const float *inv = rays[i].inv_dir;
@@ -334,17 +382,28 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
             finite &= inv[k] == inv[k];
         }
     }
-    for (; i < LANES; ++i) { /* unused lanes: lane 0's ray, never hits */
+    for (; i < LANES; ++i) {
         L->ix[i] = L->ix[0];
         L->iy[i] = L->iy[0];
         L->iz[i] = L->iz[0];
         L->tmax[i] = -1.0f;
     }
+#endif
     /* an infinite reciprocal (a zero direction component) gives box_mask's
      * NaN cases, and a tmax beyond float range inf * 0: the interval test
      * cannot bound those */
     for (k = 0; k < 3; ++k) finite &= P->ilo[k] > -FLT_MAX && P->ihi[k] < FLT_MAX;
     P->usable = finite && P->tmax < FLT_MAX;
+    return 1;
+}
+
+/* Starts T on the root. 0 when the packet cannot run as one (empty, too
+ * large, mixed octants, no tree): the caller takes the rays another way. */
+static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
+                     int *found)
+{
+    if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
+    if (!lanes_fill(&T->L, &T->P, rays, n, hits)) return 0;
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     T->rays = rays;
     T->hits = hits;
