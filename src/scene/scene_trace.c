@@ -139,6 +139,16 @@ void rc__scene_hit_prefetch(const rc_scene *scene, const rc__hit *hit, int stage
     for (i = 0; i < 3; ++i) RC__PREFETCH(mesh->vertices + (size_t)tri[i] * mesh->stride);
 }
 
+/* r * (px, py, pz) in double, r row-major 3x3 (force-inlined: the results
+ * stay in registers). */
+static RC__FORCE_INLINE void rot_d(const double r[9], double px, double py, double pz, double *x, double *y,
+                                   double *z)
+{
+    *x = r[0] * px + r[1] * py + r[2] * pz;
+    *y = r[3] * px + r[4] * py + r[5] * pz;
+    *z = r[6] * px + r[7] * py + r[8] * pz;
+}
+
 /* Written with scalar locals, not arrays: gcc pairs array elements into
  * 16-byte loads of values it had just stored 8 bytes at a time, and the CPU
  * cannot forward two stores into one load (a stall of a dozen cycles or
@@ -152,31 +162,22 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
     const float *p0 = mesh->vertices + (size_t)tri[0] * mesh->stride;
     const float *p1 = mesh->vertices + (size_t)tri[1] * mesh->stride;
     const float *p2 = mesh->vertices + (size_t)tri[2] * mesh->stride;
-    const double *rd = world->rd;
-    const double sx = dir_s[0], sy = dir_s[1], sz = dir_s[2];
-    /* the ray in the scene frame, in double */
-    const double dx = rd[0] * sx + rd[1] * sy + rd[2] * sz;
-    const double dy = rd[3] * sx + rd[4] * sy + rd[5] * sz;
-    const double dz = rd[6] * sx + rd[7] * sy + rd[8] * sz;
-    double ox = world->td[0], oy = world->td[1], oz = world->td[2];
+    double dx, dy, dz, ox = world->td[0], oy = world->td[1], oz = world->td[2];
     double ax, ay, az, bx, by, bz, cx, cy, cz, e1x, e1y, e1z, e2x, e2y, e2z, nx, ny, nz, dn, w;
+    /* the ray in the scene frame, in double */
+    rot_d(world->rd, dir_s[0], dir_s[1], dir_s[2], &dx, &dy, &dz);
     if (org_s) {
-        const double px = org_s[0], py = org_s[1], pz = org_s[2];
-        ox += rd[0] * px + rd[1] * py + rd[2] * pz;
-        oy += rd[3] * px + rd[4] * py + rd[5] * pz;
-        oz += rd[6] * px + rd[7] * py + rd[8] * pz;
+        double px, py, pz;
+        rot_d(world->rd, org_s[0], org_s[1], org_s[2], &px, &py, &pz);
+        ox += px, oy += py, oz += pz;
     }
     if (x) {
-        const double *r = x->rd, *t = x->td;
-        ax = r[0] * p0[0] + r[1] * p0[1] + r[2] * p0[2] + t[0];
-        ay = r[3] * p0[0] + r[4] * p0[1] + r[5] * p0[2] + t[1];
-        az = r[6] * p0[0] + r[7] * p0[1] + r[8] * p0[2] + t[2];
-        bx = r[0] * p1[0] + r[1] * p1[1] + r[2] * p1[2] + t[0];
-        by = r[3] * p1[0] + r[4] * p1[1] + r[5] * p1[2] + t[1];
-        bz = r[6] * p1[0] + r[7] * p1[1] + r[8] * p1[2] + t[2];
-        cx = r[0] * p2[0] + r[1] * p2[1] + r[2] * p2[2] + t[0];
-        cy = r[3] * p2[0] + r[4] * p2[1] + r[5] * p2[2] + t[1];
-        cz = r[6] * p2[0] + r[7] * p2[1] + r[8] * p2[2] + t[2];
+        rot_d(x->rd, p0[0], p0[1], p0[2], &ax, &ay, &az);
+        rot_d(x->rd, p1[0], p1[1], p1[2], &bx, &by, &bz);
+        rot_d(x->rd, p2[0], p2[1], p2[2], &cx, &cy, &cz);
+        ax += x->td[0], ay += x->td[1], az += x->td[2];
+        bx += x->td[0], by += x->td[1], bz += x->td[2];
+        cx += x->td[0], cy += x->td[1], cz += x->td[2];
     } else {
         ax = p0[0], ay = p0[1], az = p0[2];
         bx = p1[0], by = p1[1], bz = p1[2];
