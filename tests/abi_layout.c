@@ -126,7 +126,8 @@ int main(int argc, char **argv)
     S(rc_context_desc);
     F(rc_context_desc, struct_size); F(rc_context_desc, backend); F(rc_context_desc, thread_count);
     F(rc_context_desc, flags); F(rc_context_desc, memory); F(rc_context_desc, memory_size);
-    F(rc_context_desc, log); F(rc_context_desc, log_user); F(rc_context_desc, reserved);
+    F(rc_context_desc, log); F(rc_context_desc, log_user); F(rc_context_desc, device);
+    F(rc_context_desc, backend_budget_mib); F(rc_context_desc, reserved);
     end();
 
     S(rc_memory_stats);
@@ -138,7 +139,8 @@ int main(int argc, char **argv)
     S(rc_scene_desc);
     F(rc_scene_desc, struct_size); F(rc_scene_desc, max_geometries); F(rc_scene_desc, max_instances);
     F(rc_scene_desc, flags); F(rc_scene_desc, max_triangles); F(rc_scene_desc, max_vertices);
-    F(rc_scene_desc, max_copied_triangles); F(rc_scene_desc, reserved);
+    F(rc_scene_desc, max_copied_triangles); F(rc_scene_desc, origin); F(rc_scene_desc, build_quality);
+    F(rc_scene_desc, reserved);
     end();
 
     S(rc_mesh_desc);

@@ -206,6 +206,13 @@ static void test_scene_desc_bad_input(void **state)
     sd.flags = 1;
     EXPECT_FAIL(f, rc_scene_create(f->ctx, &sd, &s), RC_ERR_INVALID_ARGUMENT, "flags");
     sd.flags = 0;
+    sd.build_quality = RC_BUILD_COMPACT + 1u;
+    EXPECT_FAIL(f, rc_scene_create(f->ctx, &sd, &s), RC_ERR_INVALID_ARGUMENT, "build_quality");
+    EXPECT_FAIL(f, rc_scene_memory_requirements(f->ctx, &sd, &bytes), RC_ERR_INVALID_ARGUMENT, "build_quality");
+    sd.build_quality = RC_BUILD_BALANCED;
+    sd.reserved[6] = 1;
+    EXPECT_FAIL(f, rc_scene_create(f->ctx, &sd, &s), RC_ERR_INVALID_ARGUMENT, "reserved[6]");
+    sd.reserved[6] = 0;
     sd.max_triangles = (uint64_t)1 << 40;
     EXPECT_FAIL(f, rc_scene_memory_requirements(f->ctx, &sd, &bytes), RC_ERR_INVALID_ARGUMENT, "max_triangles");
     sd.max_triangles = 10;

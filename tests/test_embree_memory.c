@@ -1,7 +1,8 @@
 /* The Embree backend's memory and errors: the memory monitor behind
- * rc_memory_stats.backend_bytes, zero-copy sharing of mesh arrays, the
- * internal budget (RC_ERR_OUT_OF_MEMORY, a scene that stays uncommitted and
- * commits once the budget allows), the exact arena figures, and Embree
+ * rc_memory_stats.backend_bytes, zero-copy sharing of mesh arrays, the budget
+ * (public, rc_context_desc.backend_budget_mib, and internal, to the byte):
+ * RC_ERR_OUT_OF_MEMORY, a scene that stays uncommitted and commits once the
+ * budget allows; the exact arena figures, and Embree
  * errors turned into status codes with Embree's message. */
 #include <math.h>
 #include <stdlib.h>
@@ -163,6 +164,18 @@ static void test_budget(void **state)
     rc_context_destroy(ctx);
 }
 
+/* The public budget, rc_context_desc.backend_budget_mib: 1 MiB cannot hold
+ * the 100k-triangle sphere's Embree BVH (about 7 MB); 64 MiB can. */
+static void test_public_budget(void **state)
+{
+    rcu_mesh m;
+    (void)state;
+    NEED_EMBREE();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000, &m), 0);
+    rct_check_budget(RC_BACKEND_EMBREE, &m, RC_PRESET_VELODYNE_VLP16_360, 16u * 360u, 19.9f, 20.0f);
+    rcu_mesh_free(&m);
+}
+
 /* rc_scene_memory_requirements is exact on Embree too (the arena holds only
  * the backend's small tables; Embree's memory is outside it): the queried
  * block works, one byte less fails cleanly with RC_ERR_OUT_OF_MEMORY. */
@@ -279,6 +292,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_monitor_and_sharing),
         cmocka_unit_test(test_budget),
+        cmocka_unit_test(test_public_budget),
         cmocka_unit_test(test_arena_exact),
         cmocka_unit_test(test_error_mapping),
     };

@@ -372,15 +372,18 @@ static void test_parity(void **state)
     free(dirs);
 }
 
-/* Build quality and the robust flag are commit options; every quality gives
- * the same answers. */
+/* rc_scene_desc.build_quality: every value gives the built-in backend's
+ * answers on both backends (the built-in one accepts and ignores it), and on
+ * Embree COMPACT holds fewer bytes than BALANCED. */
 static void test_build_quality(void **state)
 {
-    static const uint32_t qualities[] = {RC__EMBREE_QUALITY_LOW, RC__EMBREE_QUALITY_MEDIUM, RC__EMBREE_QUALITY_HIGH};
+    static const uint32_t qualities[] = {RC_BUILD_BALANCED, RC_BUILD_FAST, RC_BUILD_HIGH, RC_BUILD_COMPACT};
+    static const uint32_t backends[] = {RC_BACKEND_BVH, RC_BACKEND_EMBREE};
     rcu_mesh m;
     rct_buffers ref, cur;
     rc_pose poses[3];
-    uint32_t q, rays = 16u * 360u;
+    uint64_t embree_bytes[4] = {0, 0, 0, 0};
+    uint32_t q, b, rays = 16u * 360u;
     (void)state;
     if (!rct_backend_usable(RC_BACKEND_EMBREE)) skip();
     assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &m), 0);
@@ -395,28 +398,38 @@ static void test_build_quality(void **state)
         RCT_OK(ctx, rc_simulate(ctx, s, sensor, poses, 3, &ref.res));
         rc_context_destroy(ctx);
     }
-    for (q = 0; q < 3; ++q) {
-        rc_context *ctx = rct_context(RC_BACKEND_EMBREE, 2, 0);
-        rc__embree_options *opt = rc__embree_options_of(ctx);
-        rc_scene *s;
-        rc_sensor *sensor;
-        uint32_t i;
-        assert_int_equal(opt->robust, 1);
-        assert_int_equal(opt->tie_rule, 1);
-        assert_int_equal(opt->budget_bytes, 0);
-        opt->build_quality = qualities[q];
-        s = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
-        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16_360, &sensor));
-        RCT_OK(ctx, rc_simulate(ctx, s, sensor, poses, 3, &cur.res));
-        for (i = 0; i < 3u * rays; ++i) {
-            assert_int_equal(cur.res.hits[i], 1);
-            assert_int_equal(ref.res.hits[i], 1);
-            if (fabs(cur.res.ranges[i] - ref.res.ranges[i]) > RANGE_REL * ref.res.ranges[i])
-                fail_msg("quality %u, ray %u: %.9g vs %.9g", (unsigned)qualities[q], (unsigned)i,
-                         (double)cur.res.ranges[i], (double)ref.res.ranges[i]);
+    for (b = 0; b < 2; ++b)
+        for (q = 0; q < 4; ++q) {
+            rc_context *ctx = rct_context(backends[b], 2, 0);
+            rc_memory_stats ms = rc_memory_stats_default();
+            rc_scene *s = rct_scene_uncommitted(ctx, &m, RC_MESH_REFERENCE, qualities[q]);
+            rc_sensor *sensor;
+            uint32_t i;
+            RCT_OK(ctx, rc_scene_commit(s));
+            RCT_OK(ctx, rc_context_get_memory_stats(ctx, &ms));
+            if (backends[b] == RC_BACKEND_EMBREE) {
+                const rc__embree_options *opt = rc__embree_options_of(ctx);
+                assert_int_equal(opt->robust, 1); /* robust whatever the quality */
+                assert_int_equal(opt->tie_rule, 1);
+                assert_int_equal(opt->budget_bytes, 0);
+                embree_bytes[q] = ms.backend_bytes;
+            }
+            RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16_360, &sensor));
+            RCT_OK(ctx, rc_simulate(ctx, s, sensor, poses, 3, &cur.res));
+            for (i = 0; i < 3u * rays; ++i) {
+                assert_int_equal(cur.res.hits[i], 1);
+                assert_int_equal(ref.res.hits[i], 1);
+                if (fabs(cur.res.ranges[i] - ref.res.ranges[i]) > RANGE_REL * ref.res.ranges[i])
+                    fail_msg("%s, build quality %u, ray %u: %.9g vs %.9g", rc_backend_name(backends[b]),
+                             (unsigned)qualities[q], (unsigned)i, (double)cur.res.ranges[i],
+                             (double)ref.res.ranges[i]);
+            }
+            rc_context_destroy(ctx);
         }
-        rc_context_destroy(ctx);
-    }
+    print_message("Embree bytes: balanced %llu, fast %llu, high %llu, compact %llu\n",
+                  (unsigned long long)embree_bytes[0], (unsigned long long)embree_bytes[1],
+                  (unsigned long long)embree_bytes[2], (unsigned long long)embree_bytes[3]);
+    assert_true(embree_bytes[3] > 0 && embree_bytes[3] < embree_bytes[0]);
     rct_buffers_free(&ref);
     rct_buffers_free(&cur);
     rcu_mesh_free(&m);

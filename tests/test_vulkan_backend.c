@@ -314,6 +314,18 @@ static void test_memory_accounting(void **state)
     rcu_mesh_free(&m);
 }
 
+/* rc_context_desc.backend_budget_mib caps the device memory: 1 MiB cannot
+ * hold the 100k-triangle sphere (its index array alone is 1.2 MB); 64 MiB can. */
+static void test_budget(void **state)
+{
+    rcu_mesh m;
+    (void)state;
+    NEED_VULKAN();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000, &m), 0);
+    rct_check_budget(RC_BACKEND_VULKAN, &m, RC_PRESET_VELODYNE_VLP16, 16u * 900u, 19.9f, 20.0f);
+    rcu_mesh_free(&m);
+}
+
 /* A scene over the (test-lowered) binding limit: RC_ERR_OUT_OF_MEMORY naming
  * the array and maxStorageBufferRange; the context stays usable. */
 static void test_binding_limits(void **state)
@@ -472,7 +484,8 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_result_names),    cmocka_unit_test(test_layout_contract),
         cmocka_unit_test(test_packed_arrays),   cmocka_unit_test(test_device_choice),
-        cmocka_unit_test(test_memory_accounting), cmocka_unit_test(test_binding_limits),
+        cmocka_unit_test(test_memory_accounting), cmocka_unit_test(test_budget),
+        cmocka_unit_test(test_binding_limits),
         cmocka_unit_test(test_sensor_cache),    cmocka_unit_test(test_device_lost),
         cmocka_unit_test(test_no_driver),
     };

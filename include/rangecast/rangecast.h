@@ -184,7 +184,16 @@ typedef struct rc_context_desc {
      * the device name. No match: RC_ERR_UNSUPPORTED. Read during create only.
      * (The environment variable RANGECAST_VULKAN_DEVICE is used when NULL.) */
     const char *device;
-    uint32_t reserved[8];   /* must be 0 */
+    /* Most memory, in MiB, the backend may hold outside the arena; 0 =
+     * unlimited. Embree: its BVHs and buffers, as its memory monitor counts
+     * them, plus the backend's commit tables (rc_memory_stats.backend_bytes).
+     * Vulkan: the device memory of its buffers (rc_memory_stats.device_bytes).
+     * An allocation that would pass it fails the call that needs it (a
+     * commit, a sensor, a simulate) with RC_ERR_OUT_OF_MEMORY and a message
+     * naming the budget; a scene whose commit failed stays uncommitted. The
+     * built-in backend holds nothing outside the arena and ignores it. */
+    uint32_t backend_budget_mib;
+    uint32_t reserved[7];   /* must be 0 */
 } rc_context_desc;
 
 #define RC_ARENA_ALIGNMENT 16u
@@ -274,8 +283,25 @@ typedef struct rc_scene_desc {
      * pass poses with rc_simulate_d. Must be finite; 0 for ordinary maps.
      * Used only when this scene is the one simulated (not as an instance). */
     double origin[3];
-    uint32_t reserved[8];
+    /* RC_BUILD_*: what the commit's acceleration structure favours. Every
+     * value gives the same ranges; the built-in backend has one build (binned
+     * SAH, about 31 bytes a triangle) and accepts every value. */
+    uint32_t build_quality;
+    uint32_t reserved[7];
 } rc_scene_desc;
+
+/* rc_scene_desc.build_quality. Embree: BALANCED is its default binned SAH
+ * (RTC_BUILD_QUALITY_MEDIUM); FAST its Morton builder (LOW: builds several
+ * times faster, traces slower; for maps rebuilt often); HIGH adds spatial
+ * splits (HIGH: slowest build, fastest tracing on long thin triangles);
+ * COMPACT keeps BALANCED's build with RTC_SCENE_FLAG_COMPACT (leaves point
+ * into the mesh arrays instead of copying vertices: least memory, slower
+ * tracing). Embree scenes are always robust (RTC_SCENE_FLAG_ROBUST): its
+ * default tests let rays slip through shared edges of closed meshes. */
+#define RC_BUILD_BALANCED 0u /* default */
+#define RC_BUILD_FAST     1u
+#define RC_BUILD_HIGH     2u
+#define RC_BUILD_COMPACT  3u
 
 RC_API rc_scene_desc rc_scene_desc_default(void);
 

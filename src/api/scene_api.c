@@ -44,9 +44,12 @@ rc_scene_info rc_scene_info_default(void)
 static rc_status check_scene_desc(rc_context *ctx, const rc_scene_desc *desc)
 {
     RC_TRY(rc__check_desc(ctx, desc, (uint32_t)sizeof *desc, (uint32_t)sizeof *desc, "desc"));
-    RC_TRY(rc__check_reserved(ctx, desc->reserved, 8, "desc"));
+    RC_TRY(rc__check_reserved(ctx, desc->reserved, sizeof desc->reserved / sizeof desc->reserved[0], "desc"));
     RC_RETURN_IF(ctx, desc->flags != 0, RC_ERR_INVALID_ARGUMENT, "desc->flags is 0x%x; no flags are defined yet",
                  (unsigned)desc->flags);
+    RC_RETURN_IF(ctx, desc->build_quality > RC_BUILD_COMPACT, RC_ERR_INVALID_ARGUMENT,
+                 "desc->build_quality is %u; use RC_BUILD_BALANCED, _FAST, _HIGH or _COMPACT (0..3)",
+                 (unsigned)desc->build_quality);
     RC_RETURN_IF(ctx, desc->max_triangles > 0xFFFFFFF0u, RC_ERR_INVALID_ARGUMENT,
                  "desc->max_triangles is %llu; at most 4294967280 are supported",
                  (unsigned long long)desc->max_triangles);

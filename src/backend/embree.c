@@ -6,8 +6,9 @@
  *   context's thread count) for its builds. Embree allocates internally (tier 2
  *   of the memory rules): every allocation goes through the memory monitor,
  *   which counts it (rc_memory_stats.backend_bytes) and refuses it past the
- *   internal budget (rc__embree_options.budget_bytes, 0 = unlimited, the
- *   default; the arena size never covers Embree). A refused allocation makes
+ *   budget (rc_context_desc.backend_budget_mib, kept in
+ *   rc__embree_options.budget_bytes; 0 = unlimited, the default; the arena
+ *   size never covers Embree). A refused allocation makes
  *   Embree abandon the commit with RTC_ERROR_OUT_OF_MEMORY, which becomes
  *   RC_ERR_OUT_OF_MEMORY.
  * - Errors: device creation failure, the device's error callback, and
@@ -219,9 +220,9 @@ static rc_status emb_init(rc_context *ctx, const rc_context_desc *desc)
     rc__emb_device *d;
     char config[64];
     rc_status st;
-    (void)desc;
     d = (rc__emb_device *)rc__arena_calloc(&ctx->arena, sizeof *d);
     RC_RETURN_IF(ctx, d == NULL, RC_ERR_OUT_OF_MEMORY, "arena has no room for the Embree backend's state");
+    d->options.budget_bytes = (uint64_t)desc->backend_budget_mib << 20;
     d->options.robust = 1;
     d->options.tie_rule = 1;
     snprintf(config, sizeof config, "threads=%u,verbose=0", (unsigned)ctx->thread_count);

@@ -5,8 +5,9 @@
  * A context created with RC_BACKEND_EMBREE (or AUTO resolving to it) carries
  * one rc__embree_options, filled with the defaults below at create; change
  * fields between calls (never while rc_simulate runs). Options read at commit
- * (budget, build quality, robust, tie rule) apply to the next commit of each
- * scene; packet_width applies to the next simulate. */
+ * (budget, robust, tie rule) apply to the next commit of each scene;
+ * packet_width applies to the next simulate. A scene's build quality is public:
+ * rc_scene_desc.build_quality. */
 #ifndef RC_BACKEND_EMBREE_INTERNAL_H
 #define RC_BACKEND_EMBREE_INTERNAL_H
 
@@ -14,23 +15,14 @@
 
 #include <stdint.h>
 
-/* Build quality of Embree's BVH (RTC_BUILD_QUALITY_*): LOW builds fastest
- * (Morton), MEDIUM is Embree's default (binned SAH), HIGH adds spatial splits
- * (slowest build, fastest traversal on long thin triangles). */
-#define RC__EMBREE_QUALITY_DEFAULT 0u /* = MEDIUM */
-#define RC__EMBREE_QUALITY_LOW     1u
-#define RC__EMBREE_QUALITY_MEDIUM  2u
-#define RC__EMBREE_QUALITY_HIGH    3u
-
 typedef struct rc__embree_options {
     /* Bytes Embree may hold outside the arena (its BVHs and buffers, as its
      * memory monitor reports them, plus the backend's own commit tables).
-     * 0 = unlimited (the default: the arena size never covers Embree). An
-     * allocation that would pass it makes the commit fail with
-     * RC_ERR_OUT_OF_MEMORY; the scene stays uncommitted and can be committed
-     * again after raising the budget. */
+     * 0 = unlimited. Set at create from rc_context_desc.backend_budget_mib;
+     * tests change it to the byte. An allocation that would pass it makes the
+     * commit fail with RC_ERR_OUT_OF_MEMORY; the scene stays uncommitted and
+     * can be committed again after raising the budget. */
     uint64_t budget_bytes;
-    uint32_t build_quality;   /* RC__EMBREE_QUALITY_* */
     /* 1 (default): RTC_SCENE_FLAG_ROBUST. Without it Embree's faster triangle
      * and box tests let rays slip through shared edges of closed meshes. */
     uint32_t robust;

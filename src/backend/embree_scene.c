@@ -218,13 +218,22 @@ static void copy_vertices(const rc__mesh *m, float *dst)
     for (i = 0; i < m->vertex_count; ++i) memcpy(dst + (size_t)i * 3u, m->vertices + (size_t)i * m->stride, 12u);
 }
 
-static enum RTCBuildQuality quality_of(uint32_t q)
+/* Embree's build quality for a scene's rc_scene_desc.build_quality (COMPACT
+ * builds as BALANCED; its flag is in scene_flags). */
+static enum RTCBuildQuality quality_of(const rc_scene *scene)
 {
-    switch (q) {
-    case RC__EMBREE_QUALITY_LOW: return RTC_BUILD_QUALITY_LOW;
-    case RC__EMBREE_QUALITY_HIGH: return RTC_BUILD_QUALITY_HIGH;
+    switch (scene->desc.build_quality) {
+    case RC_BUILD_FAST: return RTC_BUILD_QUALITY_LOW;
+    case RC_BUILD_HIGH: return RTC_BUILD_QUALITY_HIGH;
     default: return RTC_BUILD_QUALITY_MEDIUM;
     }
+}
+
+static enum RTCSceneFlags scene_flags(const rc__emb_device *d, const rc_scene *scene)
+{
+    int flags = d->options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE;
+    if (scene->desc.build_quality == RC_BUILD_COMPACT) flags |= RTC_SCENE_FLAG_COMPACT;
+    return (enum RTCSceneFlags)flags;
 }
 
 static rc_status geometry_create(rc__emb_device *d, rc__emb_scene *es, const rc_scene *scene, uint32_t gi)
@@ -249,7 +258,7 @@ static rc_status geometry_create(rc__emb_device *d, rc__emb_scene *es, const rc_
     }
     rtcSetSharedGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, m->indices, 0,
                                3u * sizeof(uint32_t), m->triangle_count);
-    rtcSetGeometryBuildQuality(geom, quality_of(d->options.build_quality));
+    rtcSetGeometryBuildQuality(geom, quality_of(scene));
     rtcCommitGeometry(geom);
     st = rc__emb_check(d, "rc_scene_commit (mesh geometry)");
     if (st == RC_OK) {
@@ -381,8 +390,8 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
      * here came through the error callback between calls. */
     RC_TRY(rc__emb_check(d, "rc_scene_commit (pending)"));
     RC_TRY(scene_state(d, scene, &es));
-    rtcSetSceneFlags(es->scene, d->options.robust ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
-    rtcSetSceneBuildQuality(es->scene, quality_of(d->options.build_quality));
+    rtcSetSceneFlags(es->scene, scene_flags(d, scene));
+    rtcSetSceneBuildQuality(es->scene, quality_of(scene));
     for (i = 0; i < scene->geom_count; ++i) {
         rc__geometry *geo = &scene->geoms[i];
         rc__emb_geom *g = &es->geoms[i];

@@ -66,6 +66,7 @@ static rc_status vk_init(rc_context *ctx, const rc_context_desc *desc)
                  (unsigned long long)rc__arena_cost(sizeof *st));
     st->ctx = ctx;
     st->want_device = desc->device;
+    st->budget_bytes = (uint64_t)desc->backend_budget_mib << 20;
     ctx->backend_data = st;
     s = rc__vk_device_create(st);
     st->want_device = NULL; /* the caller's string is not kept */

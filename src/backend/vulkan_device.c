@@ -361,6 +361,14 @@ rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kin
         rc__vk_buffer_destroy(st, out);
         return rc__fail(st->ctx, RC_ERR_UNSUPPORTED, "vulkan: no memory type for the %s buffer", what);
     }
+    if (st->budget_bytes && st->device_bytes + req.size > st->budget_bytes) {
+        rc__vk_buffer_destroy(st, out);
+        return rc__fail(st->ctx, RC_ERR_OUT_OF_MEMORY,
+                        "vulkan: the %s buffer needs %llu bytes; with the %llu bytes held it would pass the "
+                        "backend budget of %llu bytes (rc_context_desc.backend_budget_mib)",
+                        what, (unsigned long long)req.size, (unsigned long long)st->device_bytes,
+                        (unsigned long long)st->budget_bytes);
+    }
     memset(&ai, 0, sizeof ai);
     ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     ai.allocationSize = req.size;

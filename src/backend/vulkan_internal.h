@@ -93,6 +93,7 @@ typedef struct rc__vk_state {
     VkAllocationCallbacks alloc;
     uint64_t host_bytes;     /* bytes the driver holds through our callbacks */
     uint64_t device_bytes;   /* bytes of VkDeviceMemory we hold, all kinds */
+    uint64_t budget_bytes;   /* most device_bytes may reach (rc_context_desc.backend_budget_mib); 0 = no limit */
     uint64_t heap_bytes;     /* of which in RC__VK_MEM_DEVICE memory */
 
     VkInstance instance;

@@ -54,7 +54,7 @@ rc_context *rct_context(uint32_t backend, uint32_t threads, size_t arena_mb)
     return ctx;
 }
 
-rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
+rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags, uint32_t build_quality)
 {
     rc_scene_desc sd = rc_scene_desc_default();
     rc_mesh_desc md = rc_mesh_desc_default();
@@ -66,6 +66,7 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
         sd.max_vertices = mesh->vertex_count;
         sd.max_copied_triangles = mesh->triangle_count;
     }
+    sd.build_quality = build_quality;
     RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
     md.flags = flags;
     md.vertices = mesh->vertices;
@@ -74,6 +75,65 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
     md.triangle_count = mesh->triangle_count;
     RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &geom));
     assert_int_equal(geom, 0);
+    return scene;
+}
+
+static uint64_t budgeted_bytes(rc_context *ctx, uint32_t backend)
+{
+    rc_memory_stats ms = rc_memory_stats_default();
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &ms));
+    return backend == RC_BACKEND_VULKAN ? ms.device_bytes : ms.backend_bytes;
+}
+
+void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, uint32_t rays, float r_lo,
+                      float r_hi)
+{
+    static const uint32_t budgets_mib[] = {1u, 64u};
+    rct_buffers buf;
+    rc_pose pose = rct_pose(0, 0, 0);
+    uint32_t b, i;
+    rct_buffers_alloc(&buf, rays, RC_ATTR_HITS | RC_ATTR_RANGES);
+    for (b = 0; b < 2; ++b) {
+        rc_context_desc d = rc_context_desc_default();
+        rc_scene_info info = rc_scene_info_default();
+        rc_context *ctx = NULL;
+        rc_scene *scene;
+        rc_sensor *sensor;
+        uint64_t budget = (uint64_t)budgets_mib[b] << 20;
+        rc_status st;
+        d.backend = backend;
+        d.thread_count = 2;
+        d.memory_size = (size_t)64 << 20;
+        d.backend_budget_mib = budgets_mib[b];
+        RCT_OK(NULL, rc_context_create(&d, &ctx));
+        RCT_OK(ctx, rc_sensor_create_preset(ctx, preset, &sensor));
+        scene = rct_scene_uncommitted(ctx, mesh, RC_MESH_REFERENCE, RC_BUILD_BALANCED);
+        st = rc_scene_commit(scene);
+        assert_true(budgeted_bytes(ctx, backend) <= budget);
+        if (budgets_mib[b] == 1u) {
+            if (st != RC_ERR_OUT_OF_MEMORY || !strstr(rc_context_last_error(ctx), "budget"))
+                fail_msg("%s, 1 MiB budget: commit gave %s (%s)", rc_backend_name(backend), rc_status_string(st),
+                         rc_context_last_error(ctx));
+            print_message("%s: %s\n", rc_backend_name(backend), rc_context_last_error(ctx));
+            RCT_OK(ctx, rc_scene_get_info(scene, &info));
+            assert_int_equal(info.committed, 0);
+            assert_int_equal(rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res), RC_ERR_NOT_COMMITTED);
+        } else {
+            RCT_OK(ctx, st);
+            RCT_OK(ctx, rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res));
+            for (i = 0; i < rays; ++i) {
+                assert_int_equal(buf.res.hits[i], 1);
+                assert_true(buf.res.ranges[i] >= r_lo && buf.res.ranges[i] <= r_hi);
+            }
+        }
+        rc_context_destroy(ctx);
+    }
+    rct_buffers_free(&buf);
+}
+
+rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
+{
+    rc_scene *scene = rct_scene_uncommitted(ctx, mesh, flags, RC_BUILD_BALANCED);
     RCT_OK(ctx, rc_scene_commit(scene));
     return scene;
 }

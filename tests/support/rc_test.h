@@ -32,6 +32,17 @@ rc_context *rct_context(uint32_t backend, uint32_t threads, size_t arena_mb);
 
 /* A committed scene holding one referenced (or copied) mesh. */
 rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags);
+/* The same, built with build_quality (RC_BUILD_*), not yet committed. */
+rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags, uint32_t build_quality);
+
+/* rc_context_desc.backend_budget_mib on a backend that allocates outside the
+ * arena (Embree: backend_bytes; Vulkan: device_bytes): with 1 MiB, committing
+ * mesh (too large for it) fails with RC_ERR_OUT_OF_MEMORY naming the budget,
+ * holds no more than the budget (also after the failure), leaves the scene
+ * uncommitted and simulate refuses it; with 64 MiB the commit passes and a sensor (preset, rays a scan)
+ * at the origin sees every ray hit within [r_lo, r_hi]. */
+void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, uint32_t rays, float r_lo,
+                      float r_hi);
 
 /* O1Dn sensor over n directions (copied), range [rmin, rmax]. */
 rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax);

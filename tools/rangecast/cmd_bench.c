@@ -48,6 +48,8 @@ static void usage(FILE *f)
         "                     random directions, fixed layout), the ray order for --ranges-out\n"
         "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
         "  --device NAME      vulkan: device index or name substring (default: first GPU, else any)\n"
+        "  --build-quality Q  balanced (default), fast, high, compact: rc_scene_desc.build_quality\n"
+        "                     (Embree's build; the built-in backend has one build)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
@@ -59,7 +61,8 @@ static void usage(FILE *f)
         "JSON keys: backend threads sensor map triangles vertices poses rays_per_scan repeat\n"
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
-        "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent.\n"
+        "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
+        "build_quality.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
         "Timing: all poses, up to 1000 a call, ranges only, after a warm-up of 8 scans.\n"
@@ -244,6 +247,9 @@ static int parse_args(int argc, char **argv, bench_args *a)
         } else if (OPT("--device")) {
             if (r < 0) return -1;
             rcp_device = v;
+        } else if (OPT("--build-quality")) {
+            if (r < 0) return -1;
+            if (rcp_parse_build_quality(cmd, v, &rcp_build_quality) != 0) return -1;
         } else if (OPT("--threads")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &a->threads) != 0 || a->threads > RC_MAX_THREADS)
@@ -643,8 +649,9 @@ int rcp_cmd_bench(int argc, char **argv)
         printf(",\"hit_mismatch\":");
         if (is_sphere) printf("%llu", (unsigned long long)acc.mismatch);
         else printf("null");
-        printf(",\"ranges_consistent\":%s}\n",
-               acc.differing == 0 && acc.inconsistent == 0 && acc.bad_prims == 0 ? "true" : "false");
+        printf(",\"ranges_consistent\":%s,\"build_quality\":\"%s\"}\n",
+               acc.differing == 0 && acc.inconsistent == 0 && acc.bad_prims == 0 ? "true" : "false",
+               rcp_build_quality_name(rcp_build_quality));
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;

@@ -159,6 +159,29 @@ int rcp_parse_backend(const char *cmd, const char *s, uint32_t *backend)
     return 0;
 }
 
+/* Indexed by RC_BUILD_* (0..3). */
+static const char *const build_quality_names[] = {"balanced", "fast", "high", "compact"};
+
+int rcp_parse_build_quality(const char *cmd, const char *s, uint32_t *quality)
+{
+    uint32_t q;
+    for (q = 0; q < sizeof build_quality_names / sizeof build_quality_names[0]; ++q)
+        if (strcmp(s, build_quality_names[q]) == 0) {
+            *quality = q;
+            return 0;
+        }
+    rcp_usage_error(cmd, "unknown build quality '%s' (choose balanced, fast, high or compact)", s);
+    return -1;
+}
+
+const char *rcp_build_quality_name(uint32_t quality)
+{
+    return quality < sizeof build_quality_names / sizeof build_quality_names[0] ? build_quality_names[quality]
+                                                                                 : "unknown";
+}
+
+uint32_t rcp_build_quality = RC_BUILD_BALANCED;
+
 static const char *const sensor_names[] = {"vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40"};
 
 int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset)
@@ -185,6 +208,7 @@ static rc_scene_desc scene_desc_for(const rcu_mesh *mesh)
     sd.max_triangles = mesh->triangle_count;
     sd.max_vertices = 0;          /* the mesh is referenced in place, not copied */
     sd.max_copied_triangles = 0;
+    sd.build_quality = rcp_build_quality;
     return sd;
 }
 

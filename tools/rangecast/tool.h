@@ -51,6 +51,10 @@ int rcp_parse_floats(const char *s, float *out, int n);
 int rcp_parse_backend(const char *cmd, const char *s, uint32_t *backend);
 /* "bvh, embree" ... : the backends built in. */
 const char *rcp_available_backends(char *buf, size_t size);
+/* balanced | fast | high | compact -> RC_BUILD_*, or -1 with a message. */
+int rcp_parse_build_quality(const char *cmd, const char *s, uint32_t *quality);
+/* RC_BUILD_* -> its name ("unknown" past the last). */
+const char *rcp_build_quality_name(uint32_t quality);
 /* A preset name -> RC_PRESET_*, or -1 with a message listing the presets. */
 int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset);
 
@@ -73,6 +77,8 @@ typedef struct rcp_world {
  * RCP_EXIT_FAIL with *world cleaned up. */
 /* --device of bench/simulate: the Vulkan device (rc_context_desc.device); NULL = default. */
 extern const char *rcp_device;
+/* --build-quality of bench: the scene's rc_scene_desc.build_quality (RC_BUILD_*). */
+extern uint32_t rcp_build_quality;
 
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *world);
