@@ -316,7 +316,8 @@ RC_API rc_scene_desc rc_scene_desc_default(void);
  * unused part back afterwards (rc_scene_info.bytes is what it keeps); a commit
  * after rc_scene_add_mesh rebuilds every mesh and needs the whole reservation
  * again, so leave that room free (rc_scene_update_mesh only refits, in place).
- * Embree and Vulkan also allocate outside the arena (rc_memory_stats). */
+ * Embree and Vulkan also allocate outside the arena (rc_memory_stats;
+ * rc_context_desc.backend_budget_mib caps it). */
 RC_API rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_desc *desc,
                                               size_t *bytes);
 
