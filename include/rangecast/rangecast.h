@@ -290,14 +290,15 @@ typedef struct rc_scene_desc {
     uint32_t reserved[7];
 } rc_scene_desc;
 
-/* rc_scene_desc.build_quality. Embree: BALANCED is its default binned SAH
- * (RTC_BUILD_QUALITY_MEDIUM); FAST its Morton builder (LOW: builds several
- * times faster, traces slower; for maps rebuilt often); HIGH adds spatial
- * splits (HIGH: slowest build, fastest tracing on long thin triangles);
- * COMPACT keeps BALANCED's build with RTC_SCENE_FLAG_COMPACT (leaves point
- * into the mesh arrays instead of copying vertices: least memory, slower
- * tracing). Embree scenes are always robust (RTC_SCENE_FLAG_ROBUST): its
- * default tests let rays slip through shared edges of closed meshes. */
+/* rc_scene_desc.build_quality. Embree: BALANCED is its default build
+ * (RTC_BUILD_QUALITY_MEDIUM); FAST its quickest (LOW, a two-level structure:
+ * for maps rebuilt often); HIGH asks for its spatial-split build (HIGH: for
+ * long thin triangles; slower to build); COMPACT is BALANCED with
+ * RTC_SCENE_FLAG_COMPACT (least memory, slower tracing). On the 1M-triangle
+ * sphere (docs/benchmarks.md) FAST built 2.6x faster, held 41% more and
+ * traced 4% slower; COMPACT held 43% less and traced 21% slower; HIGH was
+ * BALANCED's equal. Embree scenes are always robust (RTC_SCENE_FLAG_ROBUST):
+ * its default tests let rays slip through shared edges of closed meshes. */
 #define RC_BUILD_BALANCED 0u /* default */
 #define RC_BUILD_FAST     1u
 #define RC_BUILD_HIGH     2u
