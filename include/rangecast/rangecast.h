@@ -292,8 +292,8 @@ typedef struct rc_scene_desc {
 
 /* rc_scene_desc.build_quality. Embree: BALANCED is its default build
  * (RTC_BUILD_QUALITY_MEDIUM); FAST its quickest (LOW, a two-level structure:
- * for maps rebuilt often); HIGH asks for its spatial-split build (HIGH: for
- * long thin triangles; slower to build); COMPACT is BALANCED with
+ * for maps rebuilt often); HIGH asks for its spatial-split build (HIGH,
+ * meant for long thin triangles); COMPACT is BALANCED with
  * RTC_SCENE_FLAG_COMPACT (least memory, slower tracing). On the 1M-triangle
  * sphere (docs/benchmarks.md) FAST built 2.6x faster, held 41% more and
  * traced 4% slower; COMPACT held 43% less and traced 21% slower; HIGH was

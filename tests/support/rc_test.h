@@ -38,8 +38,8 @@ rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t 
 /* rc_context_desc.backend_budget_mib on a backend that allocates outside the
  * arena (Embree: backend_bytes; Vulkan: device_bytes): with 1 MiB, committing
  * mesh (too large for it) fails with RC_ERR_OUT_OF_MEMORY naming the budget,
- * holds no more than the budget (also after the failure), leaves the scene
- * uncommitted and simulate refuses it; with 64 MiB the commit passes and a sensor (preset, rays a scan)
+ * holds no more than the budget (also after the failure; Vulkan holds what it
+ * held before), leaves the scene uncommitted and simulate refuses it; with 64 MiB the commit passes and a sensor (preset, rays a scan)
  * at the origin sees every ray hit within [r_lo, r_hi]. */
 void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, uint32_t rays, float r_lo,
                       float r_hi);
