@@ -84,28 +84,6 @@ int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
     return found;
 }
 
-void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3])
-{
-    float local[3];
-    double len;
-    if (hit->inst == RC_INVALID_ID) {
-        rc__mesh_triangle_normal(&scene->geoms[hit->geom].mesh, hit->prim, local);
-        n[0] = local[0];
-        n[1] = local[1];
-        n[2] = local[2];
-    } else {
-        const rc__instance *in = &scene->insts[hit->inst];
-        rc__mesh_triangle_normal(&in->source->geoms[hit->geom].mesh, hit->prim, local);
-        rc__rot_apply_f(in->normal_to_world, local, n);
-    }
-    len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
-    if (len > 0.0) {
-        n[0] = (float)(n[0] / len);
-        n[1] = (float)(n[1] / len);
-        n[2] = (float)(n[2] / len);
-    }
-}
-
 /* The mesh of a hit and its instance transform (NULL without one). */
 static const rc__mesh *hit_mesh(const rc_scene *scene, const rc__hit *hit, const rc__xformf **x)
 {
@@ -115,6 +93,28 @@ static const rc__mesh *hit_mesh(const rc_scene *scene, const rc__hit *hit, const
     }
     *x = &scene->insts[hit->inst].to_world;
     return &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
+}
+
+void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3])
+{
+    const rc__xformf *x;
+    const rc__mesh *mesh = hit_mesh(scene, hit, &x);
+    float local[3];
+    double len;
+    rc__mesh_triangle_normal(mesh, hit->prim, local);
+    if (x) {
+        rc__rot_apply_f(scene->insts[hit->inst].normal_to_world, local, n);
+    } else {
+        n[0] = local[0];
+        n[1] = local[1];
+        n[2] = local[2];
+    }
+    len = sqrt((double)n[0] * n[0] + (double)n[1] * n[1] + (double)n[2] * n[2]);
+    if (len > 0.0) {
+        n[0] = (float)(n[0] / len);
+        n[1] = (float)(n[1] / len);
+        n[2] = (float)(n[2] / len);
+    }
 }
 
 /* The hit triangle's vertex indices: the leaf-ordered copy was just read by
