@@ -85,13 +85,16 @@ static uint64_t budgeted_bytes(rc_context *ctx, uint32_t backend)
     return backend == RC_BACKEND_VULKAN ? ms.device_bytes : ms.backend_bytes;
 }
 
-void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, uint32_t rays, float r_lo,
-                      float r_hi)
+void rct_check_budget(uint32_t backend, uint32_t preset, uint32_t rays)
 {
     static const uint32_t budgets_mib[] = {1u, 64u};
+    const float r_lo = 19.9f, r_hi = 20.0f;
+    rcu_mesh sphere;
+    const rcu_mesh *mesh = &sphere;
     rct_buffers buf;
     rc_pose pose = rct_pose(0, 0, 0);
     uint32_t b, i;
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000, &sphere), 0);
     rct_buffers_alloc(&buf, rays, RC_ATTR_HITS | RC_ATTR_RANGES);
     for (b = 0; b < 2; ++b) {
         rc_context_desc d = rc_context_desc_default();
@@ -133,6 +136,7 @@ void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, u
         rc_context_destroy(ctx);
     }
     rct_buffers_free(&buf);
+    rcu_mesh_free(&sphere);
 }
 
 rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)

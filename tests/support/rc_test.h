@@ -36,13 +36,14 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags);
 rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags, uint32_t build_quality);
 
 /* rc_context_desc.backend_budget_mib on a backend that allocates outside the
- * arena (Embree: backend_bytes; Vulkan: device_bytes): with 1 MiB, committing
- * mesh (too large for it) fails with RC_ERR_OUT_OF_MEMORY naming the budget,
- * holds no more than the budget (also after the failure; Vulkan holds what it
- * held before), leaves the scene uncommitted and simulate refuses it; with 64 MiB the commit passes and a sensor (preset, rays a scan)
- * at the origin sees every ray hit within [r_lo, r_hi]. */
-void rct_check_budget(uint32_t backend, const rcu_mesh *mesh, uint32_t preset, uint32_t rays, float r_lo,
-                      float r_hi);
+ * arena (Embree: backend_bytes; Vulkan: device_bytes), with the 100k-triangle
+ * sphere of radius 20 m (larger than 1 MiB on both): with 1 MiB, the commit
+ * fails with RC_ERR_OUT_OF_MEMORY naming the budget, holds no more than the
+ * budget (also after the failure; Vulkan holds what it held before), leaves
+ * the scene uncommitted and simulate refuses it; with 64 MiB the commit
+ * passes and a sensor (preset, rays a scan) at the centre sees every ray hit
+ * within [19.9, 20] m. */
+void rct_check_budget(uint32_t backend, uint32_t preset, uint32_t rays);
 
 /* O1Dn sensor over n directions (copied), range [rmin, rmax]. */
 rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax);
