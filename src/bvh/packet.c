@@ -300,6 +300,7 @@ typedef struct packet_trav {
     int *found;
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
+    uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
     /* up to three pushes per level */
     packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
 } packet_trav;
@@ -412,7 +413,7 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
     T->sp = 0;
     T->child = 0;
     T->count = 0;
-    T->staged = 0;
+    T->staged = T->settling = 0;
     return 1;
 }
 
@@ -425,6 +426,11 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     const rc__wnode *nodes = mesh->wide;
     packet_lanes *L = &T->L;
     uint32_t child = T->child, mask = T->mask;
+    if (T->settling) {
+        uint32_t i;
+        for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
+        return 0;
+    }
     if (T->count == 0) {
         const rc__wnode *nd = &nodes[child];
         packet_entry e[4];
@@ -497,6 +503,14 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
      * of the next turn (tmax per lane) */
     if (T->sp == 0) {
         uint32_t i;
+        if (interleaved) {
+            /* a prim id is a read from refs, a miss on a large map: prefetch
+             * them and settle in a turn of their own */
+            for (i = 0; i < T->n; ++i)
+                if (T->hits[i].prim == RC__PRIM_PENDING) RC__PREFETCH(mesh->bvh.refs + T->hits[i].slot);
+            T->settling = 1;
+            return 1;
+        }
         for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
         return 0;
     }

@@ -256,7 +256,7 @@ typedef struct ray_turns {
     rc__hit *hit;
     float tcur;
     uint32_t sp, child, count, staged;
-    int found;
+    int found, settling;
     wide_entry stack[STACK_SIZE];
 } ray_turns;
 
@@ -267,12 +267,16 @@ static void turns_start(ray_turns *T, const rc__ray *ray, rc__hit *hit)
     T->hit = hit;
     T->tcur = hit->t;
     T->sp = T->child = T->count = T->staged = 0;
-    T->found = 0;
+    T->found = T->settling = 0;
 }
 
 /* One turn of T; 0 once its traversal is over (prim id settled). */
 static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint32_t geom, uint32_t inst)
 {
+    if (T->settling) {
+        rc__hit_settle(T->hit, mesh->bvh.refs);
+        return 0;
+    }
     if (T->count == 0) {
         const rc__wnode *n = &mesh->wide[T->child];
         float tn[4] RC__ALIGN16;
@@ -316,8 +320,12 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
     }
     for (;;) {
         if (T->sp == 0) {
-            if (T->found) rc__hit_settle(T->hit, mesh->bvh.refs);
-            return 0;
+            /* the hit's prim id is a read from refs, a miss on a large map:
+             * prefetch it and settle in a turn of its own */
+            if (!T->found || T->hit->prim != RC__PRIM_PENDING) return 0;
+            RC__PREFETCH(mesh->bvh.refs + T->hit->slot);
+            T->settling = 1;
+            return 1;
         }
         --T->sp;
         if (T->stack[T->sp].tnear <= T->tcur * RC__SLAB_FAR_SCALE) {
