@@ -135,8 +135,11 @@ static int parse_header(ply_reader *r, ply_elem *elems, int *nelems)
             e = &elems[(*nelems)++];
             memset(e, 0, sizeof *e);
             strcpy(e->name, b);
+            /* digits only: strtoull would take "-3" as 2^64 - 3 */
+            errno = 0;
             e->count = strtoull(c, &endp, 10);
-            if (*endp) return rcu_fail("%s: bad element count '%s'", r->path, c);
+            if (c[0] < '0' || c[0] > '9' || *endp || errno == ERANGE)
+                return rcu_fail("%s: bad element count '%s'", r->path, c);
         } else if (strcmp(a, "property") == 0 && n >= 3) {
             ply_elem *e = *nelems ? &elems[*nelems - 1] : NULL;
             ply_prop *pr;
@@ -200,6 +203,8 @@ static int read_body(ply_reader *r, ply_elem *elems, int nelems, rcu_mesh *m)
             return rcu_fail("%s: element %s claims %llu entries, more than the file holds", r->path,
                             e->name, (unsigned long long)e->count);
         if (is_vertex) {
+            /* a second one would replace the vertices under the faces read so far */
+            if (have_vertices) return rcu_fail("%s: more than one vertex element", r->path);
             for (k = 0; k < e->nprops; k++) {
                 if (e->props[k].count_type != T_NONE) continue;
                 if (strcmp(e->props[k].name, "x") == 0) xyz[0] = k;
@@ -226,7 +231,8 @@ static int read_body(ply_reader *r, ply_elem *elems, int nelems, rcu_mesh *m)
             if (!have_vertices) return rcu_fail("%s: face element before the vertex element", r->path);
             if (grow_triangles(m, &tri_cap, e->count) != 0) return -1;
         }
-        for (i = 0; i < e->count; i++) {
+        /* an element without properties has nothing to read, however many it claims */
+        for (i = 0; e->nprops > 0 && i < e->count; i++) {
             for (k = 0; k < e->nprops; k++) {
                 const ply_prop *pr = &e->props[k];
                 double v;

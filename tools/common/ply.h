@@ -5,6 +5,8 @@
  * element face with a list property (vertex_indices / vertex_index, else the
  * first list) of any integer count and index types; polygons are split into
  * fans, faces with fewer than 3 vertices are dropped; other elements skipped.
+ * One vertex element, before the faces; element counts are plain decimal and
+ * must fit in the file (checked before anything is allocated).
  * The writer writes binary little-endian: float x y z, list uchar int
  * vertex_indices, which every PLY reader (Assimp, MeshLab, Blender, Open3D)
  * takes. */
