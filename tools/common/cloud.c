@@ -174,10 +174,13 @@ static int write_body(FILE *f, const rcu_cloud *c, int ascii)
     return ferror(f) ? -1 : 0;
 }
 
+/* Closes f; on any error removes the half-written file. */
 static int finish(FILE *f, const char *path, int st)
 {
     if (fclose(f) != 0) st = -1;
-    return st == 0 ? 0 : rcu_fail("%s: write error", path);
+    if (st == 0) return 0;
+    rcu_remove_partial(path);
+    return rcu_fail("%s: write error", path);
 }
 
 int rcu_cloud_write_ply(const char *path, const rcu_cloud *c, int ascii)

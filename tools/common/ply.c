@@ -337,9 +337,11 @@ int rcu_mesh_write_ply(const char *path, const rcu_mesh *mesh)
         }
         if (fwrite(buf, 13, n, f) != n) goto fail;
     }
-    if (fclose(f) != 0) return rcu_fail("%s: write error", path);
+    if (fclose(f) != 0) goto removed;
     return 0;
 fail:
     fclose(f);
+removed: /* nothing half-written stays behind */
+    rcu_remove_partial(path);
     return rcu_fail("%s: write error", path);
 }

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <time.h>
 
 static char rcu_error_text[512];
@@ -75,6 +76,13 @@ float rcu_load_f32le(const unsigned char *p)
     float f;
     memcpy(&f, &u, 4);
     return f;
+}
+
+void rcu_remove_partial(const char *path)
+{
+    struct stat st;
+    /* a regular file only: -o /dev/full must not delete the device */
+    if (stat(path, &st) == 0 && S_ISREG(st.st_mode)) remove(path);
 }
 
 int rcu_read_file(const char *path, unsigned char **data, size_t *size)

@@ -31,6 +31,8 @@ float rcu_load_f32le(const unsigned char *p);
 /* Reads a whole file into a malloc'd buffer (plus a terminating NUL byte not
  * counted in *size). */
 int rcu_read_file(const char *path, unsigned char **data, size_t *size);
+/* Removes what a failed write left at path, if it is a regular file. */
+void rcu_remove_partial(const char *path);
 
 /* The file name extension in lower case without the dot ("" when none), into
  * ext (at most ext_size - 1 characters). */

@@ -1,0 +1,110 @@
+#!/bin/sh
+# `rangecast gen` and `rangecast simulate` end to end, as a user runs them:
+# the files they write (PLY map, raw poses, PCD and PLY clouds, PNG image) are
+# read back and their contents checked against the closed 20 m sphere's
+# geometry; every bad input gets its exit status and a message naming it, and
+# leaves no output file behind.
+#   check_simulate.sh RANGECAST WORKDIR [--backend B]
+set -eu
+RC=$1
+WORK=$2
+shift 2
+BACKEND=${*:-}
+rm -rf "$WORK"
+mkdir -p "$WORK"
+cd "$WORK"
+
+fail() {
+    echo "FAIL: $*" >&2
+    exit 1
+}
+
+# run EXPECTED_STATUS MESSAGE_PART cmd...: the status and a stderr line containing MESSAGE_PART
+run() {
+    want=$1
+    msg=$2
+    shift 2
+    set +e
+    "$@" >out.txt 2>err.txt
+    got=$?
+    set -e
+    [ "$got" -eq "$want" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $want"; }
+    if [ -n "$msg" ] && ! grep -q -- "$msg" err.txt; then
+        cat err.txt >&2
+        fail "'$*': stderr lacks '$msg'"
+    fi
+}
+
+run 0 "" "$RC" gen --sphere 1k --radius 20 -o sphere.ply
+run 0 "" "$RC" gen --poses 3 --radius 10 --seed 7 -o poses.bin
+[ "$(wc -c <poses.bin)" -eq 84 ] || fail "3 poses are not 84 bytes"
+
+# One VLP-16 scan from the centre, sensor frame, ascii PCD with range and ring.
+# Every ray meets the sphere; the facets lie between the inscribed radius of the
+# coarse 1k sphere (above 19.5 m) and 20 m; |point| is the range; ring is the
+# row, 900 points each.
+run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o centre.pcd --ascii --fields range,ring $BACKEND
+grep -qx "FIELDS x y z range ring" centre.pcd || fail "PCD fields"
+grep -qx "POINTS 14400" centre.pcd || fail "PCD point count"
+grep -qx "DATA ascii" centre.pcd || fail "PCD data line"
+awk 'f {
+        n++
+        r = sqrt($1 * $1 + $2 * $2 + $3 * $3)
+        if ($4 < 19.5 || $4 > 20.0001) { print "range " $4 " off the sphere"; bad = 1 }
+        if (r - $4 > 1e-4 || $4 - r > 1e-4) { print "|point| " r " vs range " $4; bad = 1 }
+        if ($5 < 0 || $5 > 15) { print "ring " $5; bad = 1 }
+        ring[$5]++
+        # row 0 looks 15 degrees down, row 15 15 degrees up
+        if ($5 == 0 && $3 > -0.25 * r) { print "row 0 not looking down: z " $3; bad = 1 }
+        if ($5 == 15 && $3 < 0.25 * r) { print "row 15 not looking up: z " $3; bad = 1 }
+     }
+     /^DATA/ { f = 1 }
+     END {
+        if (n != 14400) { print "records: " n; bad = 1 }
+        for (k = 0; k < 16; k++) if (ring[k] != 900) { print "ring " k ": " ring[k] " points"; bad = 1 }
+        exit bad
+     }' centre.pcd || fail "centre.pcd contents"
+
+# The sensor turned 90 degrees about z (qz = qw = sqrt(1/2)) and moved: in the
+# map frame every point is still on the sphere.
+run 0 "" "$RC" simulate --map sphere.ply --pose 3,-2,1,0,0,0.70710678,0.70710678 --frame map -o moved.pcd \
+    --ascii $BACKEND
+awk 'f { n++; r = sqrt($1 * $1 + $2 * $2 + $3 * $3); if (r < 19.5 || r > 20.0001) { print "|p| " r; bad = 1 } }
+     /^DATA/ { f = 1 }
+     END { if (n != 14400) { print "records: " n; bad = 1 } exit bad }' moved.pcd || fail "moved.pcd contents"
+
+# Three poses from the file, binary PLY: 3 x 14,400 records of x y z range.
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three.ply --fields range $BACKEND
+grep -q "^format binary_little_endian 1.0" three.ply || fail "PLY format line"
+grep -q "^element vertex 43200" three.ply || fail "PLY vertex count"
+header=$(awk '{ n += length($0) + 1 } /^end_header/ { print n; exit }' three.ply)
+[ "$(wc -c <three.ply)" -eq $((header + 43200 * 16)) ] || fail "three.ply is not header + 43,200 x 16 bytes"
+
+# A range image when the program has PNG.
+if "$RC" help | grep -q "Images: PNG"; then
+    run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o img.pcd --image range.png $BACKEND
+    [ "$(head -c 4 range.png | od -An -c | tr -d ' ')" = "211PNG" ] || fail "range.png is not a PNG"
+fi
+
+# Bad input: exit 1 for files, 2 for arguments; nothing written.
+run 1 "nope.ply" "$RC" simulate --map nope.ply --pose 0,0,0 -o a.pcd
+head -c 27 poses.bin >short.bin
+run 1 "not a multiple of 28" "$RC" simulate --map sphere.ply --poses short.bin -o b.pcd
+printf 'ply\nformat ascii 1.0\nelement vertex 3\nend_header\n' >broken.ply
+run 1 "broken.ply" "$RC" simulate --map broken.ply --pose 0,0,0 -o c.pcd
+run 2 "must be .ply or .pcd" "$RC" simulate --map sphere.ply --pose 0,0,0 -o d.xyz
+run 2 "unknown sensor 'foo'" "$RC" simulate --map sphere.ply --pose 0,0,0 --sensor foo -o e.pcd
+run 2 "--pose" "$RC" simulate --map sphere.ply --pose 0,0,nan -o f.pcd
+run 2 "norm 0" "$RC" simulate --map sphere.ply --pose 0,0,0,0,0,0,0 -o g.pcd
+run 1 "no_dir" "$RC" simulate --map sphere.ply --pose 0,0,0 -o no_dir/h.pcd
+# A write that fails (a full disk): exit 1 with the message; a device at the
+# path is left alone.
+if [ -c /dev/full ]; then
+    ln -s /dev/full full.pcd
+    run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd
+    [ -c /dev/full ] || fail "/dev/full was removed"
+fi
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd; do
+    [ ! -e "$f" ] || fail "$f was written by a failed run"
+done
+echo "check_simulate: all checks passed"
