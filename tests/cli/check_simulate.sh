@@ -80,6 +80,26 @@ grep -q "^element vertex 43200" three.ply || fail "PLY vertex count"
 header=$(awk '{ n += length($0) + 1 } /^end_header/ { print n; exit }' three.ply)
 [ "$(wc -c <three.ply)" -eq $((header + 43200 * 16)) ] || fail "three.ply is not header + 43,200 x 16 bytes"
 
+# bench on the same files: --ranges-out holds float32 [pose][row][column]
+# (3 x 16 x 900), every range between the nearest and farthest the sphere can
+# be from a pose inside the 10 m ball; the backend under test on 2 threads
+# gives the bits of the built-in backend on 1.
+run 0 '' "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 --ranges-out ranges.bin $BACKEND
+grep -q '"poses":3,' out.txt || fail "bench JSON: poses"
+grep -q '"hit_fraction":1,' out.txt || fail "bench JSON: hit_fraction"
+grep -q '"ranges_consistent":true' out.txt || fail "bench JSON: ranges_consistent"
+[ "$(wc -c <ranges.bin)" -eq $((3 * 14400 * 4)) ] || fail "ranges.bin is not 3 x 14,400 float32"
+od -An -v -f ranges.bin | awk '{ for (i = 1; i <= NF; i++) { n++; if (!($i >= 9.5 && $i <= 30.0001)) bad++ } }
+    END { if (n != 43200 || bad) { print n " ranges, " bad " out of [9.5, 30]"; exit 1 } }' || fail "ranges.bin values"
+run 0 '' "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 1 --ranges-out ref.bin --backend bvh
+cmp ranges.bin ref.bin || fail "ranges differ from the built-in backend's on one thread"
+# the first pose's first ray (row 0, column 0) is the range the simulate
+# command's first point has at that pose
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o first.pcd --ascii --fields range $BACKEND
+first=$(od -An -v -f -N 4 ranges.bin | tr -d ' ')
+awk -v want="$first" 'f { d = $4 - want; if (d < 0) d = -d; exit !(d <= 1e-6 * want) } /^DATA/ { f = 1 }' first.pcd ||
+    fail "simulate's first range is not bench's $first"
+
 # A range image when the program has PNG.
 if "$RC" help | grep -q "Images: PNG"; then
     run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o img.pcd --image range.png $BACKEND
