@@ -118,7 +118,7 @@ void rct_check_budget(uint32_t backend, uint32_t preset, uint32_t rays)
             if (st != RC_ERR_OUT_OF_MEMORY || !strstr(rc_context_last_error(ctx), "budget"))
                 fail_msg("%s, 1 MiB budget: commit gave %s (%s)", rc_backend_name(backend), rc_status_string(st),
                          rc_context_last_error(ctx));
-            print_message("%s: %s\n", rc_backend_name(backend), rc_context_last_error(ctx));
+            print_message("1 MiB budget refused: %s\n", rc_context_last_error(ctx));
             /* Vulkan frees every buffer of the failed commit (Embree keeps the
              * meshes it made for the next commit) */
             if (backend == RC_BACKEND_VULKAN) assert_true(budgeted_bytes(ctx, backend) == before);
