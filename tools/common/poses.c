@@ -160,10 +160,14 @@ int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count)
         for (k = 0; k < 4; k++) rcu_store_f32le(rec + 12 + 4 * k, poses[i].orientation[k]);
         if (fwrite(rec, 1, sizeof rec, f) != sizeof rec) {
             fclose(f);
+            rcu_remove_partial(path);
             return rcu_fail("%s: write error", path);
         }
     }
-    if (fclose(f) != 0) return rcu_fail("%s: write error", path);
+    if (fclose(f) != 0) {
+        rcu_remove_partial(path);
+        return rcu_fail("%s: write error", path);
+    }
     return 0;
 }
 
