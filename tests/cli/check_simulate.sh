@@ -100,6 +100,42 @@ first=$(od -An -v -f -N 4 ranges.bin | tr -d ' ')
 awk -v want="$first" 'f { d = $4 - want; if (d < 0) d = -d; exit !(d <= 1e-6 * want) } /^DATA/ { f = 1 }' first.pcd ||
     fail "simulate's first range is not bench's $first"
 
+# Other mesh formats come through Assimp when the program has it: a 10 m cube
+# as OBJ, seen from off-centre; in the map frame every point lies on a face.
+if "$RC" help | grep -q "obj, stl"; then
+    cat >cube.obj <<'OBJ'
+v -5 -5 -5
+v 5 -5 -5
+v 5 5 -5
+v -5 5 -5
+v -5 -5 5
+v 5 -5 5
+v 5 5 5
+v -5 5 5
+f 1 3 2
+f 1 4 3
+f 5 6 7
+f 5 7 8
+f 1 2 6
+f 1 6 5
+f 2 3 7
+f 2 7 6
+f 3 4 8
+f 3 8 7
+f 4 1 5
+f 4 5 8
+OBJ
+    run 0 "" "$RC" simulate --map cube.obj --pose 0.5,-1,0.25 --frame map --ascii -o cube.pcd $BACKEND
+    awk 'function abs(v) { return v < 0 ? -v : v }
+         f { n++; m = abs($1); if (abs($2) > m) m = abs($2); if (abs($3) > m) m = abs($3)
+             if (abs(m - 5) > 1e-4) { print "point " $1 " " $2 " " $3 " off the cube"; bad = 1 } }
+         /^DATA/ { f = 1 }
+         END { if (n != 14400) { print "records: " n; bad = 1 } exit bad }' cube.pcd || fail "cube.pcd contents"
+    echo "not a mesh" >bad.obj
+    run 1 "bad.obj" "$RC" simulate --map bad.obj --pose 0,0,0 -o i.pcd
+    [ ! -e i.pcd ] || fail "i.pcd was written by a failed run"
+fi
+
 # A range image when the program has PNG.
 if "$RC" help | grep -q "Images: PNG"; then
     run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o img.pcd --image range.png $BACKEND
