@@ -6,26 +6,19 @@
 set -eu
 RC=$1
 WORK=$2
-rm -rf "$WORK"
-mkdir -p "$WORK"
-cd "$WORK"
+. "$(dirname "$0")/common.sh"
 
-fail() {
-    echo "FAIL: $*" >&2
-    exit 1
-}
-
-"$RC" demo --out out >demo.txt 2>&1 || { cat demo.txt >&2; fail "demo exited $?"; }
+run 0 "" "$RC" demo --out out
 # twice: a second run overwrites its own files
-"$RC" demo --out out >demo.txt 2>&1 || { cat demo.txt >&2; fail "second demo run failed"; }
+run 0 "" "$RC" demo --out out
+cp out.txt demo.txt
 for f in demo_map.ply vlp16_scan.ply vlp16_scan.pcd d435_cloud.ply; do
     [ -s "out/$f" ] || fail "out/$f missing or empty"
     grep -q "out/$f" demo.txt || fail "demo does not announce out/$f"
 done
-if "$RC" help | grep -q "Images: PNG"; then
-    for f in vlp16_range.png d435_depth.png; do
-        [ "$(head -c 4 "out/$f" | od -An -c | tr -d ' ')" = "211PNG" ] || fail "out/$f is not a PNG"
-    done
+if has_png; then
+    is_png out/vlp16_range.png
+    is_png out/d435_depth.png
 fi
 
 # The VLP-16 cloud holds the returns the demo reports: x y z range intensity
@@ -41,11 +34,10 @@ grep -q "^element vertex $returns\$" out/vlp16_scan.ply || fail "vlp16_scan.ply 
 # The map the demo wrote is the one it traced: info reads the triangle count back.
 tris=$(sed -n 's/.*warehouse.*, \([0-9,]*\) triangles.*/\1/p' demo.txt)
 [ -n "$tris" ] || fail "demo did not print the map's triangles"
-"$RC" info --map out/demo_map.ply >info.txt 2>&1 || { cat info.txt >&2; fail "info on the demo map"; }
-grep -q "^triangles *$tris " info.txt || fail "info reads other than $tris triangles"
+run 0 "" "$RC" info --map out/demo_map.ply
+grep -q "^triangles *$tris " out.txt || fail "info reads other than $tris triangles"
 
 # The next step the demo suggests.
-"$RC" simulate --map out/demo_map.ply --pose 0,0,1 --sensor os1-64 -o os1.ply >sim.txt 2>&1 ||
-    { cat sim.txt >&2; fail "the suggested simulate command"; }
+run 0 "" "$RC" simulate --map out/demo_map.ply --pose 0,0,1 --sensor os1-64 -o os1.ply
 [ -s os1.ply ] || fail "os1.ply missing"
 echo "check_demo: all checks passed"

@@ -10,30 +10,7 @@ RC=$1
 WORK=$2
 shift 2
 BACKEND=${*:-}
-rm -rf "$WORK"
-mkdir -p "$WORK"
-cd "$WORK"
-
-fail() {
-    echo "FAIL: $*" >&2
-    exit 1
-}
-
-# run EXPECTED_STATUS MESSAGE_PART cmd...: the status and a stderr line containing MESSAGE_PART
-run() {
-    want=$1
-    msg=$2
-    shift 2
-    set +e
-    "$@" >out.txt 2>err.txt
-    got=$?
-    set -e
-    [ "$got" -eq "$want" ] || { cat err.txt >&2; fail "'$*' exited $got, expected $want"; }
-    if [ -n "$msg" ] && ! grep -q -- "$msg" err.txt; then
-        cat err.txt >&2
-        fail "'$*': stderr lacks '$msg'"
-    fi
-}
+. "$(dirname "$0")/common.sh"
 
 run 0 "" "$RC" gen --sphere 1k --radius 20 -o sphere.ply
 run 0 "" "$RC" gen --poses 3 --radius 10 --seed 7 -o poses.bin
@@ -152,9 +129,9 @@ else
 fi
 
 # A range image when the program has PNG.
-if "$RC" help | grep -q "Images: PNG"; then
+if has_png; then
     run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o img.pcd --image range.png $BACKEND
-    [ "$(head -c 4 range.png | od -An -c | tr -d ' ')" = "211PNG" ] || fail "range.png is not a PNG"
+    is_png range.png
 fi
 
 # Bad input: exit 1 for files, 2 for arguments; nothing written.
