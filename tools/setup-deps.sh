@@ -11,8 +11,9 @@ set -eu
 profile=${1:-demo}
 base="build-essential cmake pkg-config"
 demo="$base libpng-dev libassimp-dev libmeshoptimizer-dev"
-# python3-matplotlib: tools/chart.py (make accuracy-docs)
-test="$demo python3-matplotlib libcmocka-dev libembree-dev libvulkan-dev mesa-vulkan-drivers glslang-tools clang valgrind"
+# python3-matplotlib: tools/chart.py (make accuracy-docs); python3-numpy: the
+# Python binding and its tests (bindings/python)
+test="$demo python3-matplotlib python3-numpy libcmocka-dev libembree-dev libvulkan-dev mesa-vulkan-drivers glslang-tools clang valgrind"
 # qemu-user runs the cross-built tests; xz-utils unpacks the cmocka source
 # package that make cross-armhf / cross-riscv64 build (toolchains/cmocka-from-source.sh).
 cross_aarch64="$base gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user"
