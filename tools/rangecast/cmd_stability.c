@@ -23,7 +23,8 @@ static void usage(FILE *f)
         "zero-area triangle, or (coplanar case) its ids are not the smallest key.\n"
         "\n"
         "Options:\n"
-        "  --backend LIST   comma-separated: bvh, embree, vulkan (default: every backend built in)\n"
+        "  --backend LIST   comma-separated: bvh, embree, vulkan, auto (the one auto picks)\n"
+        "                   (default: every backend built in)\n"
         "  --threads N      library threads (default 2)\n"
         "  --quick          the smaller sizes the sanitizer runs use\n"
         "  --markdown       a Markdown table (with the case descriptions) instead of text\n"
@@ -34,7 +35,7 @@ int rcp_cmd_stability(int argc, char **argv)
 {
     const char *cmd = "stability";
     uint32_t backends[4], nb = 0, threads = 2, b;
-    int markdown = 0, quick = 0, i, r, c, any_wrong = 0;
+    int markdown = 0, quick = 0, listed = 0, i, r, c, any_wrong = 0;
     static rcu_stab_result results[4][RCU_STAB_CASE_COUNT];
     int ran[4][RCU_STAB_CASE_COUNT];
     for (i = 1; i < argc; i++) {
@@ -47,6 +48,7 @@ int rcp_cmd_stability(int argc, char **argv)
             char buf[128], *tok, *save = NULL;
             if (r < 0) return RCP_EXIT_USAGE;
             snprintf(buf, sizeof buf, "%s", v);
+            listed = 1;
             for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
                 if (nb == 4) return rcp_usage_error(cmd, "--backend: at most 4 backends");
                 if (rcp_parse_backend(cmd, tok, &backends[nb]) != 0) return RCP_EXIT_USAGE;
@@ -64,6 +66,15 @@ int rcp_cmd_stability(int argc, char **argv)
             return rcp_usage_error(cmd, "unknown argument '%s'", argv[i]);
         }
     }
+    if (listed && nb == 0) return rcp_usage_error(cmd, "--backend: expected a list of backends, got an empty one");
+    /* auto runs (and is reported as) the backend the library picks for it */
+    for (b = 0; b < nb; b++)
+        if (backends[b] == RC_BACKEND_AUTO) {
+            rcp_world w;
+            if (rcp_world_create(cmd, RC_BACKEND_AUTO, 1, NULL, NULL, 0, &w) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
+            backends[b] = w.backend;
+            rcp_world_destroy(&w);
+        }
     if (nb == 0) {
         static const uint32_t all[3] = {RC_BACKEND_BVH, RC_BACKEND_EMBREE, RC_BACKEND_VULKAN};
         for (b = 0; b < 3; b++)
