@@ -206,9 +206,10 @@ static void usage(FILE *f)
         "  --threads N       library threads, 0 = all CPUs (default)\n"
         "  --json            one JSON line instead of the table\n"
         "\n"
-        "JSON keys: tool backend threads sensor map triangles poses rays disagree disagree_rate\n"
-        "nan_outputs ref_returns lib_returns scans_per_s range_err_mean_m range_err_p99_m\n"
-        "range_err_p999_m range_err_max_m compared by_incidence [{deg_lo deg_hi n mean_m p999_m max_m}].\n"
+        "JSON keys: tool version backend threads sensor map triangles poses rays disagree disagree_rate\n"
+        "nan_outputs ref_returns lib_returns scans_per_s compared range_err_mean_m range_err_p99_m\n"
+        "range_err_p999_m range_err_max_m by_incidence [{deg_lo deg_hi n mean_m p999_m max_m}]\n"
+        "reference_build_s compare_s. Statistics of no rays are null.\n"
         "scans_per_s: the untimed-elsewhere simulate calls of this run (ranges only).\n");
 }
 
