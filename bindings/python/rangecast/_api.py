@@ -306,8 +306,8 @@ class Context(object):
             raise Error(F.ERR_INVALID_ARGUMENT, "poses must be (7,) or (N, 7) with N > 0: x y z qx qy qz qw, "
                         "got shape %s" % (np.shape(poses),))
         n = arr.shape[0]
-        info = sensor.info
-        rows, cols = info["rows"], info["columns"]
+        sensor._handle()  # a closed sensor fails here, before any buffer is made
+        rows, cols = sensor._grid
         res = F.lib.rc_results_default()
         res.capacity = n * rows * cols
         result = {}
@@ -520,6 +520,11 @@ def _scale3(scale):
 
 class Sensor(_Child):
     """A sensor model; its scan shape is in info."""
+
+    def __init__(self, ctx, handle):
+        _Child.__init__(self, ctx, handle)
+        info = self.info
+        self._grid = (info["rows"], info["columns"])  # fixed at create: simulate's result shape
 
     def close(self):
         if self._h is not None and self._ctx._h is not None:
