@@ -4,10 +4,15 @@ Every failing C call becomes a rangecast.Error carrying the status code and
 the context's last-error message. Objects created from a context hold it
 alive; closing the context (or leaving its `with` block) destroys them all,
 as rc_context_destroy does, and later use raises Error(ERR_INVALID_HANDLE).
+
+The C rule "a context is used by one thread at a time" is kept by a lock per
+context: ctypes lets other Python threads run during a call, so without it two
+threads could enter one context at once. Different contexts run in parallel.
 """
 
 import ctypes
 import math
+import threading
 
 import numpy as np
 
@@ -127,6 +132,9 @@ class Context(object):
                     pass
             self._log = F.LOG_FN(_relay)
             desc.log = self._log
+        self._lock = threading.Lock()
+        self._owner = None    # thread inside a C call on this context
+        self._pending = []    # (destroy function, handle) left by the garbage collector
         handle = ctypes.c_void_p()
         status = F.lib.rc_context_create(ctypes.byref(desc), ctypes.byref(handle))
         if status != F.OK:
@@ -137,9 +145,15 @@ class Context(object):
     # -- lifetime ---------------------------------------------------------
     def close(self):
         """Destroys the context and everything created from it. Idempotent."""
-        if getattr(self, "_h", None) is not None:
+        if getattr(self, "_h", None) is None:
+            return
+        self._enter("close")
+        try:
             F.lib.rc_context_destroy(self._h)
             self._h = None
+            self._pending = []
+        finally:
+            self._leave()
 
     def __enter__(self):
         return self
@@ -155,32 +169,65 @@ class Context(object):
             raise Error(F.ERR_INVALID_HANDLE, "the context is closed")
         return self._h
 
-    def _check(self, status, what):
+    def _enter(self, what):
+        if self._owner == threading.get_ident():
+            raise Error(F.ERR_MISUSE, "%s from inside a log or progress callback of the same context" % what)
+        self._lock.acquire()
+        self._owner = threading.get_ident()
+
+    def _leave(self):
+        # destroys the garbage collector asked for while a call ran
+        while self._pending and self._h is not None:
+            fn, handle = self._pending.pop()
+            fn(handle)
+        self._owner = None
+        self._lock.release()
+
+    def _call(self, what, fn, *args):
+        """fn(*args) under the context's lock; a failure raises Error with
+        the context's message, read before another call can replace it."""
+        self._enter(what)
+        try:
+            self._handle()  # closed by another thread while this one waited
+            status = fn(*args)
+            message = F.lib.rc_context_last_error(self._h).decode(errors="replace") if status != F.OK else ""
+        finally:
+            self._leave()
         if status != F.OK:
-            message = F.lib.rc_context_last_error(self._h).decode(errors="replace") if self._h else ""
             raise Error(status, message or what)
+
+    def _release(self, fn, handle):
+        """Destroys a scene or sensor the garbage collector dropped: now when
+        the context is free, else at the end of the call that holds it
+        (never inside it: a callback may be what dropped the object)."""
+        if self._h is None:
+            return  # freed with the context
+        if self._owner is None and self._lock.acquire(False):
+            self._owner = threading.get_ident()
+            self._pending.append((fn, handle))
+            self._leave()
+        else:
+            self._pending.append((fn, handle))
 
     # -- queries ----------------------------------------------------------
     @property
     def backend(self):
         """The backend in use: "bvh", "embree" or "vulkan"."""
         b = ctypes.c_uint32()
-        self._check(F.lib.rc_context_get_backend(self._handle(), ctypes.byref(b)), "rc_context_get_backend")
+        self._call("rc_context_get_backend", F.lib.rc_context_get_backend, self._handle(), ctypes.byref(b))
         return F.lib.rc_backend_name(b.value).decode()
 
     @property
     def threads(self):
         """Threads simulate uses, the caller's included."""
         n = ctypes.c_uint32()
-        self._check(F.lib.rc_context_get_thread_count(self._handle(), ctypes.byref(n)),
-                    "rc_context_get_thread_count")
+        self._call("rc_context_get_thread_count", F.lib.rc_context_get_thread_count, self._handle(), ctypes.byref(n))
         return n.value
 
     def memory_stats(self):
         """Bytes: arena_size, arena_used, arena_peak, backend_bytes, device_bytes."""
         s = F.lib.rc_memory_stats_default()
-        self._check(F.lib.rc_context_get_memory_stats(self._handle(), ctypes.byref(s)),
-                    "rc_context_get_memory_stats")
+        self._call("rc_context_get_memory_stats", F.lib.rc_context_get_memory_stats, self._handle(), ctypes.byref(s))
         return {k: int(getattr(s, k)) for k in ("arena_size", "arena_used", "arena_peak", "backend_bytes",
                                                  "device_bytes")}
 
@@ -213,8 +260,7 @@ class Context(object):
             raise Error(F.ERR_INVALID_ARGUMENT, "no sensor preset named %r (vlp16, vlp16-360, os1-64, d435, "
                         "livox-mid40)" % (name,))
         handle = ctypes.c_void_p()
-        self._check(F.lib.rc_sensor_create_preset(self._handle(), preset, ctypes.byref(handle)),
-                    "rc_sensor_create_preset")
+        self._call("rc_sensor_create_preset", F.lib.rc_sensor_create_preset, self._handle(), preset, ctypes.byref(handle))
         return Sensor(self, handle)
 
     def spherical_sensor(self, theta, phi, range_min, range_max, mounting=None):
@@ -276,7 +322,7 @@ class Context(object):
 
     def _create(self, fn, desc):
         handle = ctypes.c_void_p()
-        self._check(fn(self._handle(), ctypes.byref(desc), ctypes.byref(handle)), "sensor create")
+        self._call("sensor create", fn, self._handle(), ctypes.byref(desc), ctypes.byref(handle))
         return Sensor(self, handle)
 
     # -- simulate ---------------------------------------------------------
@@ -324,8 +370,7 @@ class Context(object):
             fn, ptr = F.lib.rc_simulate_d, arr.ctypes.data_as(ctypes.POINTER(F.PoseD))
         else:
             fn, ptr = F.lib.rc_simulate, arr.ctypes.data_as(ctypes.POINTER(F.Pose))
-        self._check(fn(h, scene._handle(), sensor._handle(), ptr, _u32(n, "pose count"), ctypes.byref(res)),
-                    "rc_simulate")
+        self._call("rc_simulate", fn, h, scene._handle(), sensor._handle(), ptr, _u32(n, "pose count"), ctypes.byref(res))
         return result
 
 
@@ -390,16 +435,21 @@ class _Child(object):
         self.close()
 
     def __del__(self):
-        if getattr(self, "_h", None) is None:
+        if getattr(self, "_h", None) is None or getattr(self, "_ctx", None) is None:
             return  # never created, or closed already
+        # a scene another scene still instances cannot go (the destroy says
+        # RC_ERR_MISUSE, ignored): it is freed with the context
         try:
-            self.close()
-        except Error:
-            pass  # e.g. a scene another scene still instances: freed with the context
+            self._ctx._release(self._destroy_fn, self._h)
+        except Exception:  # interpreter shutdown: the process frees the arena
+            pass
+        self._h = None
 
 
 class Scene(_Child):
     """A scene of meshes and instances; commit() before simulating."""
+
+    _destroy_fn = staticmethod(lambda h: F.lib.rc_scene_destroy(h))
 
     def __init__(self, ctx, max_triangles, max_geometries, max_instances, max_vertices, max_copied_triangles,
                  origin, build_quality):
@@ -413,7 +463,7 @@ class Scene(_Child):
             d.origin[i] = float(c)
         d.build_quality = _lookup(_QUALITIES, build_quality, "build_quality")
         handle = ctypes.c_void_p()
-        ctx._check(F.lib.rc_scene_create(ctx._handle(), ctypes.byref(d), ctypes.byref(handle)), "rc_scene_create")
+        ctx._call("rc_scene_create", F.lib.rc_scene_create, ctx._handle(), ctypes.byref(d), ctypes.byref(handle))
         _Child.__init__(self, ctx, handle)
         self._arrays = {}     # geom id -> (vertices, triangles) referenced in place
         self._sources = []    # scenes instanced here: kept alive as long as this one
@@ -421,7 +471,7 @@ class Scene(_Child):
     def close(self):
         """Frees the scene (it must not be instanced by a live scene)."""
         if self._h is not None and self._ctx._h is not None:
-            self._ctx._check(F.lib.rc_scene_destroy(self._h), "rc_scene_destroy")
+            self._ctx._call("rc_scene_destroy", F.lib.rc_scene_destroy, self._h)
         self._h = None
         self._arrays = {}
         self._sources = []
@@ -438,8 +488,7 @@ class Scene(_Child):
         d.indices = _ptr(t, ctypes.c_uint32)
         d.triangle_count = t.shape[0]
         gid = ctypes.c_uint32()
-        self._ctx._check(F.lib.rc_scene_add_mesh(self._handle(), ctypes.byref(d), ctypes.byref(gid)),
-                         "rc_scene_add_mesh")
+        self._ctx._call("rc_scene_add_mesh", F.lib.rc_scene_add_mesh, self._handle(), ctypes.byref(d), ctypes.byref(gid))
         if not copy:
             self._arrays[gid.value] = (v, t)
         return gid.value
@@ -453,8 +502,7 @@ class Scene(_Child):
             raise Error(F.ERR_INVALID_ARGUMENT, "geometry %r is not a referenced mesh of this scene" % (geom_id,))
 
     def update_mesh(self, geom_id):
-        self._ctx._check(F.lib.rc_scene_update_mesh(self._handle(), _u32(geom_id, "geom_id")),
-                         "rc_scene_update_mesh")
+        self._ctx._call("rc_scene_update_mesh", F.lib.rc_scene_update_mesh, self._handle(), _u32(geom_id, "geom_id"))
 
     def add_instance(self, source, pose=None, scale=1.0):
         """Places the committed scene source (meshes only) here; pose is
@@ -466,17 +514,14 @@ class Scene(_Child):
         d.transform = _pose(pose)
         d.scale[:] = _scale3(scale)
         iid = ctypes.c_uint32()
-        self._ctx._check(F.lib.rc_scene_add_instance(self._handle(), ctypes.byref(d), ctypes.byref(iid)),
-                         "rc_scene_add_instance")
+        self._ctx._call("rc_scene_add_instance", F.lib.rc_scene_add_instance, self._handle(), ctypes.byref(d), ctypes.byref(iid))
         self._sources.append(source)
         return iid.value
 
     def set_instance_transform(self, inst_id, pose, scale=1.0):
         p = _pose(pose)
         s = (ctypes.c_float * 3)(*_scale3(scale))
-        self._ctx._check(F.lib.rc_scene_set_instance_transform(self._handle(), _u32(inst_id, "inst_id"),
-                                                               ctypes.byref(p), s),
-                         "rc_scene_set_instance_transform")
+        self._ctx._call("rc_scene_set_instance_transform", F.lib.rc_scene_set_instance_transform, self._handle(), _u32(inst_id, "inst_id"), ctypes.byref(p), s)
 
     def commit(self, progress=None):
         """Builds or refits the acceleration structure. progress: an optional
@@ -490,20 +535,19 @@ class Scene(_Child):
                     pass
                 return 1
             cb = F.PROGRESS_FN(_relay)
-        self._ctx._check(F.lib.rc_scene_commit_with_progress(self._handle(), cb, None), "rc_scene_commit")
+        self._ctx._call("rc_scene_commit", F.lib.rc_scene_commit_with_progress, self._handle(), cb, None)
 
     @property
     def bounds(self):
         """(6,) float32: min x y z, max x y z of the committed scene."""
         b = np.empty(6, dtype=np.float32)
-        self._ctx._check(F.lib.rc_scene_get_bounds(self._handle(), _ptr(b, ctypes.c_float)),
-                         "rc_scene_get_bounds")
+        self._ctx._call("rc_scene_get_bounds", F.lib.rc_scene_get_bounds, self._handle(), _ptr(b, ctypes.c_float))
         return b
 
     @property
     def info(self):
         i = F.lib.rc_scene_info_default()
-        self._ctx._check(F.lib.rc_scene_get_info(self._handle(), ctypes.byref(i)), "rc_scene_get_info")
+        self._ctx._call("rc_scene_get_info", F.lib.rc_scene_get_info, self._handle(), ctypes.byref(i))
         return {"geometry_count": i.geometry_count, "instance_count": i.instance_count,
                 "committed": bool(i.committed), "triangle_count": int(i.triangle_count),
                 "bvh_nodes": int(i.bvh_nodes), "bytes": int(i.bytes)}
@@ -521,6 +565,8 @@ def _scale3(scale):
 class Sensor(_Child):
     """A sensor model; its scan shape is in info."""
 
+    _destroy_fn = staticmethod(lambda h: F.lib.rc_sensor_destroy(h))
+
     def __init__(self, ctx, handle):
         _Child.__init__(self, ctx, handle)
         info = self.info
@@ -528,21 +574,21 @@ class Sensor(_Child):
 
     def close(self):
         if self._h is not None and self._ctx._h is not None:
-            self._ctx._check(F.lib.rc_sensor_destroy(self._h), "rc_sensor_destroy")
+            self._ctx._call("rc_sensor_destroy", F.lib.rc_sensor_destroy, self._h)
         self._h = None
 
     @property
     def info(self):
         """model, rows, columns, rays_per_scan, range_min, range_max."""
         i = F.lib.rc_sensor_info_default()
-        self._ctx._check(F.lib.rc_sensor_get_info(self._handle(), ctypes.byref(i)), "rc_sensor_get_info")
+        self._ctx._call("rc_sensor_get_info", F.lib.rc_sensor_get_info, self._handle(), ctypes.byref(i))
         return {"model": _MODELS.get(i.model, "unknown"), "rows": i.rows, "columns": i.columns,
                 "rays_per_scan": i.rays_per_scan, "range_min": i.range_min, "range_max": i.range_max}
 
     def set_mounting(self, sensor_to_base):
         """Moves the sensor on the robot (7 numbers x y z qx qy qz qw)."""
         p = _pose(sensor_to_base)
-        self._ctx._check(F.lib.rc_sensor_set_mounting(self._handle(), ctypes.byref(p)), "rc_sensor_set_mounting")
+        self._ctx._call("rc_sensor_set_mounting", F.lib.rc_sensor_set_mounting, self._handle(), ctypes.byref(p))
 
 
 def quaternion_from_euler(roll, pitch, yaw):
