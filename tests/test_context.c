@@ -1,5 +1,6 @@
 /* Contexts: descriptor checks, caller blocks, errors, memory figures, and the
  * exact size queries (the queried size works, one byte less fails cleanly). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -249,12 +250,76 @@ static void test_log_callback(void **state)
     rc_context_destroy(ctx);
 }
 
+/* A failed create has no context: its message goes to the log callback, and
+ * it names the field. */
+static char last_log[1024];
+static void keep_log(void *user, uint32_t level, const char *msg)
+{
+    (void)user;
+    if (level == RC_LOG_ERROR) snprintf(last_log, sizeof last_log, "%s", msg);
+}
+
+static void expect_create(rc_context_desc *d, rc_status status, const char *part)
+{
+    rc_context *ctx = NULL;
+    last_log[0] = '\0';
+    d->log = keep_log;
+    assert_int_equal(rc_context_create(d, &ctx), status);
+    assert_null(ctx);
+    if (!strstr(last_log, part)) fail_msg("create's message '%s' lacks '%s'", last_log, part);
+}
+
+static void test_create_messages_name_the_field(void **state)
+{
+    rc_context_desc d;
+    static unsigned char raw[4096 + 16];
+    unsigned char *aligned = raw + ((16u - (uintptr_t)raw % 16u) % 16u);
+    (void)state;
+    d = rc_context_desc_default();
+    d.struct_size = 8;
+    expect_create(&d, RC_ERR_STRUCT_SIZE, "desc->struct_size is 8");
+    d = rc_context_desc_default();
+    d.reserved[3] = 1;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->reserved[3] is 1");
+    d = rc_context_desc_default();
+    d.backend = 42;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->backend is 42");
+    d = rc_context_desc_default();
+    d.thread_count = RC_MAX_THREADS + 1;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->thread_count is 257");
+    d = rc_context_desc_default();
+    d.flags = 4;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->flags is 4");
+    d = rc_context_desc_default();
+    d.memory = aligned + 4;
+    d.memory_size = 4000;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "not aligned to RC_ARENA_ALIGNMENT");
+    d.memory = aligned;
+    d.memory_size = 0;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->memory_size is 0");
+    d.memory_size = 64;
+    expect_create(&d, RC_ERR_OUT_OF_MEMORY, "desc->memory_size is 64 bytes; this context needs");
+    if (!rc_backend_available(RC_BACKEND_EMBREE)) {
+        d = rc_context_desc_default();
+        d.backend = RC_BACKEND_EMBREE;
+        expect_create(&d, RC_ERR_UNSUPPORTED, "embree is not built into this library");
+    }
+    if (rc_backend_available(RC_BACKEND_VULKAN)) {
+        /* the backend's own reason comes through */
+        d = rc_context_desc_default();
+        d.backend = RC_BACKEND_VULKAN;
+        d.device = "no-such-gpu-anywhere";
+        expect_create(&d, RC_ERR_UNSUPPORTED, "no-such-gpu-anywhere");
+    }
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_version),          cmocka_unit_test(test_bad_descs),
         cmocka_unit_test(test_caller_block_and_stats), cmocka_unit_test(test_arena_sizing_exact),
         cmocka_unit_test(test_bytes_per_triangle), cmocka_unit_test(test_log_callback),
+        cmocka_unit_test(test_create_messages_name_the_field),
     };
     return cmocka_run_group_tests_name("context", tests, NULL, NULL);
 }

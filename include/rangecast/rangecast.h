@@ -221,7 +221,10 @@ RC_API rc_status rc_context_memory_requirements(const rc_context_desc *desc, siz
  * only on RC_OK.
  * Returns RC_ERR_INVALID_ARGUMENT, RC_ERR_STRUCT_SIZE, RC_ERR_OUT_OF_MEMORY
  * (block too small or malloc failed), RC_ERR_UNSUPPORTED (backend absent or no
- * device), RC_ERR_BACKEND. Thread-safe (it touches no shared state). */
+ * device), RC_ERR_BACKEND. Thread-safe (it touches no shared state). With no
+ * context to hold it, a failure's message (naming the desc field, or the
+ * backend's own reason, e.g. the Vulkan device that matched nothing) goes to
+ * desc->log at RC_LOG_ERROR. */
 RC_API rc_status rc_context_create(const rc_context_desc *desc, rc_context **out);
 
 /* Destroys the context, every scene and sensor created from it, joins the

@@ -5,6 +5,8 @@
 #include "backend/backend.h"
 #include "core/context.h"
 
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #if defined(__linux__)
@@ -60,18 +62,50 @@ rc_memory_stats rc_memory_stats_default(void)
     return s;
 }
 
-/* Checks the desc and resolves backend and thread count. */
-static rc_status resolve_desc(const rc_context_desc *desc, const rc__backend **backend, uint32_t *threads)
+/* A create-time failure's message, into why[RC__ERROR_TEXT]: there is no
+ * context to hold it yet. */
+static rc_status why_fail(char *why, rc_status status, const char *fmt, ...) RC__PRINTF(3, 4);
+static rc_status why_fail(char *why, rc_status status, const char *fmt, ...)
 {
-    RC_TRY(rc__check_desc(NULL, desc, CONTEXT_DESC_MIN_SIZE, (uint32_t)sizeof(rc_context_desc), "desc"));
-    RC_TRY(rc__check_reserved(NULL, desc->reserved, sizeof desc->reserved / sizeof desc->reserved[0], "desc"));
-    if (desc->flags != 0) return RC_ERR_INVALID_ARGUMENT;
-    if (desc->backend > RC_BACKEND_VULKAN) return RC_ERR_INVALID_ARGUMENT;
-    if (desc->thread_count > RC_MAX_THREADS) return RC_ERR_INVALID_ARGUMENT;
-    if (desc->memory && ((uintptr_t)desc->memory % RC_ARENA_ALIGNMENT) != 0) return RC_ERR_INVALID_ARGUMENT;
-    if (desc->memory && desc->memory_size == 0) return RC_ERR_INVALID_ARGUMENT;
+    va_list ap;
+    va_start(ap, fmt);
+    if (vsnprintf(why, RC__ERROR_TEXT, fmt, ap) < 0) why[0] = '\0';
+    va_end(ap);
+    return status;
+}
+
+/* Checks the desc and resolves backend and thread count; why names the
+ * field on failure. */
+static rc_status resolve_desc(const rc_context_desc *desc, const rc__backend **backend, uint32_t *threads, char *why)
+{
+    size_t i;
+    if (!desc) return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc is NULL");
+    if (desc->struct_size != (uint32_t)sizeof(rc_context_desc))
+        return why_fail(why, RC_ERR_STRUCT_SIZE,
+                        "desc->struct_size is %u; this library knows %u (use rc_context_desc_default())",
+                        (unsigned)desc->struct_size, (unsigned)sizeof(rc_context_desc));
+    for (i = 0; i < sizeof desc->reserved / sizeof desc->reserved[0]; ++i)
+        if (desc->reserved[i] != 0)
+            return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->reserved[%u] is %u; reserved words must be 0",
+                            (unsigned)i, (unsigned)desc->reserved[i]);
+    if (desc->flags != 0)
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->flags is %u; none are defined, it must be 0",
+                        (unsigned)desc->flags);
+    if (desc->backend > RC_BACKEND_VULKAN)
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->backend is %u; not an RC_BACKEND_* value",
+                        (unsigned)desc->backend);
+    if (desc->thread_count > RC_MAX_THREADS)
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->thread_count is %u; at most RC_MAX_THREADS (%u)",
+                        (unsigned)desc->thread_count, RC_MAX_THREADS);
+    if (desc->memory && ((uintptr_t)desc->memory % RC_ARENA_ALIGNMENT) != 0)
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->memory %p is not aligned to RC_ARENA_ALIGNMENT (%u)",
+                        desc->memory, RC_ARENA_ALIGNMENT);
+    if (desc->memory && desc->memory_size == 0)
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->memory is set but desc->memory_size is 0");
     *backend = rc__backend_find(desc->backend);
-    if (!*backend) return RC_ERR_UNSUPPORTED;
+    if (!*backend)
+        return why_fail(why, RC_ERR_UNSUPPORTED, "desc->backend %s is not built into this library",
+                        rc_backend_name(desc->backend));
     *threads = desc->thread_count ? desc->thread_count : rc__cpu_count();
 #if !defined(RANGECAST_WITH_THREADS)
     *threads = 1;
@@ -88,16 +122,25 @@ rc_status rc_context_memory_requirements(const rc_context_desc *desc, size_t *by
 {
     const rc__backend *backend = NULL;
     uint32_t threads = 1;
+    char why[RC__ERROR_TEXT];
     if (!bytes) return RC_ERR_INVALID_ARGUMENT;
-    RC_TRY(resolve_desc(desc, &backend, &threads));
+    RC_TRY(resolve_desc(desc, &backend, &threads, why));
     *bytes = context_bytes(desc, backend, threads);
     return RC_OK;
 }
 
-/* Messages for create failures go to the log callback only: there is no context yet. */
-static rc_status create_fail(const rc_context_desc *desc, rc_status status, const char *msg)
+/* Messages for create failures go to the log callback only: there is no
+ * context yet. */
+static rc_status create_fail(const rc_context_desc *desc, rc_status status, const char *fmt, ...) RC__PRINTF(3, 4);
+static rc_status create_fail(const rc_context_desc *desc, rc_status status, const char *fmt, ...)
 {
-    if (desc && desc->log) desc->log(desc->log_user, RC_LOG_ERROR, msg);
+    char msg[RC__ERROR_TEXT];
+    va_list ap;
+    if (!desc || !desc->log) return status;
+    va_start(ap, fmt);
+    if (vsnprintf(msg, sizeof msg, fmt, ap) < 0) msg[0] = '\0';
+    va_end(ap);
+    desc->log(desc->log_user, RC_LOG_ERROR, msg);
     return status;
 }
 
@@ -111,17 +154,21 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
     size_t size;
     rc_context *ctx;
     rc_status st;
+    char why[RC__ERROR_TEXT];
 
     if (!out) return create_fail(desc, RC_ERR_INVALID_ARGUMENT, "rc_context_create: out is NULL");
-    st = resolve_desc(desc, &backend, &threads);
-    if (st != RC_OK) return create_fail(desc, st, "rc_context_create: bad desc (see the status)");
+    st = resolve_desc(desc, &backend, &threads, why);
+    if (st != RC_OK) return create_fail(desc, st, "rc_context_create: %s", why);
     if (desc->backend != RC_BACKEND_AUTO && !backend->available())
-        return create_fail(desc, RC_ERR_UNSUPPORTED, "rc_context_create: backend not usable here");
+        return create_fail(desc, RC_ERR_UNSUPPORTED, "rc_context_create: backend %s is built in but not usable here",
+                           backend->name);
 
     size = desc->memory ? desc->memory_size : (desc->memory_size ? desc->memory_size : RC_DEFAULT_ARENA_SIZE);
     if (size < context_bytes(desc, backend, threads))
-        return create_fail(desc, RC_ERR_OUT_OF_MEMORY, "rc_context_create: memory_size is smaller than "
-                                                       "rc_context_memory_requirements");
+        return create_fail(desc, RC_ERR_OUT_OF_MEMORY,
+                           "rc_context_create: desc->memory_size is %lu bytes; this context needs %lu "
+                           "(rc_context_memory_requirements)",
+                           (unsigned long)size, (unsigned long)context_bytes(desc, backend, threads));
     block = desc->memory;
     if (!block) {
         /* The one allocation of the library. malloc aligns to 16 on x86_64
@@ -165,18 +212,26 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
     if (st != RC_OK && ctx->pool && desc->backend == RC_BACKEND_AUTO && backend != &rc__backend_bvh) {
         /* AUTO: a backend that is built in but cannot start here (no device)
          * falls back to the built-in one. Its failed init released what it took. */
-        if (desc->log) desc->log(desc->log_user, RC_LOG_WARN, "AUTO: preferred backend failed to start; using bvh");
+        if (desc->log) {
+            char warn[RC__ERROR_TEXT + 64];
+            snprintf(warn, sizeof warn, "AUTO: %s failed to start (%s); using bvh", backend->name, ctx->last_error);
+            desc->log(desc->log_user, RC_LOG_WARN, warn);
+        }
         backend = &rc__backend_bvh;
         ctx->backend = backend;
         ctx->backend_id = backend->id;
         st = backend->init(ctx, desc);
     }
     if (st != RC_OK) {
+        /* the reason is in the dying context's last error: copy it out first */
+        memcpy(why, ctx->last_error, sizeof why);
+        why[sizeof why - 1] = '\0';
+        if (!ctx->pool) snprintf(why, sizeof why, "%u worker threads could not start", (unsigned)(threads - 1));
         if (ctx->pool) rc__pool_destroy(&ctx->arena, ctx->pool);
         ctx->magic = RC__MAGIC_DEAD;
         rc__arena_fini(&ctx->arena);
         free(owned);
-        return create_fail(desc, st, "rc_context_create: thread or backend start failed");
+        return create_fail(desc, st, "rc_context_create: %s", why[0] ? why : "the backend failed to start");
     }
     *out = ctx;
     return RC_OK;

@@ -123,23 +123,30 @@ class Context(object):
         self._device = device.encode() if isinstance(device, str) else (None if device is None else
                                                                           str(device).encode())
         desc.device = self._device
-        self._log = None
-        if log is not None:
-            def _relay(_user, level, message):
+        # The log relay is always installed: a failed create has no context
+        # to hold its message, only the log line says why. (It captures a
+        # list, not self: no reference cycle.)
+        create_errors = []
+
+        def _relay(_user, level, message):
+            text = message.decode(errors="replace")
+            if create_errors is not None and level == 1:
+                create_errors.append(text)
+            if log is not None:
                 try:
-                    log(int(level), message.decode(errors="replace"))
+                    log(int(level), text)
                 except Exception:  # an exception must not cross the C frames
                     pass
-            self._log = F.LOG_FN(_relay)
-            desc.log = self._log
+        self._log = F.LOG_FN(_relay)
+        desc.log = self._log
         self._lock = threading.Lock()
         self._owner = None    # thread inside a C call on this context
         self._pending = []    # (destroy function, handle) left by the garbage collector
         handle = ctypes.c_void_p()
         status = F.lib.rc_context_create(ctypes.byref(desc), ctypes.byref(handle))
         if status != F.OK:
-            raise Error(status, "rc_context_create failed (backend %r, %d threads, arena %d bytes)" %
-                        (backend, threads, arena_bytes))
+            raise Error(status, create_errors[-1] if create_errors else "rc_context_create failed")
+        del create_errors[:]
         self._h = handle
 
     # -- lifetime ---------------------------------------------------------

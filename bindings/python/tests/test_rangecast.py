@@ -350,6 +350,8 @@ class TestBadInput(Base):
         self.assertStatus(F.ERR_NOT_COMMITTED, "", self.ctx.simulate, fresh, self.lidar, IDENTITY)
         self.assertStatus(F.ERR_INVALID_ARGUMENT, "no sensor preset named 'hdl64'", self.ctx.preset_sensor, "hdl64")
         self.assertStatus(F.ERR_INVALID_ARGUMENT, "backend 'optix'", rangecast.Context, backend="optix")
+        # a failed create's message comes from the library's log line
+        self.assertStatus(F.ERR_INVALID_ARGUMENT, "desc->thread_count is 100000", rangecast.Context, threads=100000)
         self.assertStatus(F.ERR_INVALID_ARGUMENT, "range", self.ctx.spherical_sensor, (0, 0.1, 3), (0, 0.1, 1),
                           5.0, 1.0)
         self.assertStatus(F.ERR_NON_FINITE, "", self.ctx.rays_sensor, [[np.nan, 0, 1]], 0.1, 10.0)
