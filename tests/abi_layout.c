@@ -197,6 +197,12 @@ int main(int argc, char **argv)
     F(rc_sensor_info, range_max); F(rc_sensor_info, reserved);
     end();
 
+    S(rc_noise_desc);
+    F(rc_noise_desc, struct_size); F(rc_noise_desc, reserved0); F(rc_noise_desc, mean); F(rc_noise_desc, sigma);
+    F(rc_noise_desc, sigma_exponent); F(rc_noise_desc, dropout); F(rc_noise_desc, seed);
+    F(rc_noise_desc, reserved);
+    end();
+
     S(rc_results);
     F(rc_results, struct_size); F(rc_results, attributes); F(rc_results, capacity); F(rc_results, hits);
     F(rc_results, ranges); F(rc_results, points); F(rc_results, normals); F(rc_results, prim_ids);

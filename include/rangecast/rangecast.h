@@ -563,6 +563,45 @@ RC_API rc_status rc_sensor_get_info(const rc_sensor *sensor, rc_sensor_info *inf
 /* Moves the sensor on the robot (takes effect at the next simulate). */
 RC_API rc_status rc_sensor_set_mounting(rc_sensor *sensor, const rc_pose *sensor_to_base);
 
+/* Range noise and dropout, applied to every simulate with this sensor after
+ * tracing, the same way on every backend:
+ *   a return's range r becomes r + mean + sigma * r^sigma_exponent * z,
+ *   z ~ N(0, 1), clamped to [range_min, range_max] (noise never turns a
+ *   return into a miss); its point moves along its ray to the new range
+ *   (normals and ids stay);
+ *   with probability dropout a return is lost instead: hit 0, range +inf,
+ *   point and normal NaN, ids RC_INVALID_ID.
+ * sigma_exponent 0 gives constant noise (LiDARs), 1 noise proportional to
+ * range, 2 the quadratic growth of stereo depth cameras. Misses and -inf
+ * (nearer than range_min) are left alone.
+ * The numbers come from a counter-based generator keyed by seed, the
+ * element index (pose * rays_per_scan + ray) and a draw count: the n-th
+ * successful simulate with this sensor since rc_sensor_set_noise uses draw n.
+ * The same calls in the same order give the same noise for any thread count
+ * and backend; each call gets fresh noise. Returns are told apart by the
+ * requested attributes (hits, ranges, points, normals, prim or geom ids): a
+ * request of inst_ids alone is left as traced. Results kept on the device
+ * (RC_RESULTS_ON_DEVICE) cannot have noise: simulate returns
+ * RC_ERR_UNSUPPORTED. */
+typedef struct rc_noise_desc {
+    uint32_t struct_size;
+    uint32_t reserved0;
+    float mean;            /* m, added to every return (a range bias) */
+    float sigma;           /* m at 1 m when sigma_exponent > 0; >= 0 */
+    float sigma_exponent;  /* >= 0 */
+    float dropout;         /* probability a return is lost, in [0, 1] */
+    uint64_t seed;
+    uint32_t reserved[8];
+} rc_noise_desc;
+
+/* Every field 0 (no noise) but struct_size. Thread-safe. */
+RC_API rc_noise_desc rc_noise_desc_default(void);
+/* Sets (or with NULL, or a desc whose mean, sigma and dropout are all 0,
+ * removes) the sensor's noise and restarts its draw count. Non-finite values:
+ * RC_ERR_NON_FINITE; sigma or sigma_exponent < 0, dropout outside [0, 1]:
+ * RC_ERR_INVALID_ARGUMENT; a failed call leaves the noise as it was. */
+RC_API rc_status rc_sensor_set_noise(rc_sensor *sensor, const rc_noise_desc *noise);
+
 /* ------------------------------------------------------------------------ */
 /* Simulate                                                                  */
 /* ------------------------------------------------------------------------ */

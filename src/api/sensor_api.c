@@ -412,6 +412,23 @@ rc_status rc_sensor_get_info(const rc_sensor *sensor, rc_sensor_info *info)
     return RC_OK;
 }
 
+rc_noise_desc rc_noise_desc_default(void)
+{
+    rc_noise_desc d;
+    memset(&d, 0, sizeof d);
+    d.struct_size = (uint32_t)sizeof d;
+    return d;
+}
+
+rc_status rc_sensor_set_noise(rc_sensor *sensor, const rc_noise_desc *noise)
+{
+    if (!rc__sensor_valid(sensor)) return RC_ERR_INVALID_HANDLE;
+    rc__clear_error(sensor->ctx);
+    if (noise) RC_TRY(rc__noise_check(sensor->ctx, noise));
+    rc__noise_set(&sensor->noise, noise);
+    return RC_OK;
+}
+
 rc_status rc_sensor_set_mounting(rc_sensor *sensor, const rc_pose *sensor_to_base)
 {
     rc_context *ctx;

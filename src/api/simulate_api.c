@@ -43,6 +43,9 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
                  "results->flags has RC_RESULTS_ON_DEVICE, but the context's backend (%s) has no device: "
                  "results can only go to host buffers",
                  ctx->backend->name);
+    RC_RETURN_IF(ctx, (results->flags & RC_RESULTS_ON_DEVICE) && sensor->noise.enabled, RC_ERR_UNSUPPORTED,
+                 "results->flags has RC_RESULTS_ON_DEVICE, but the sensor has noise (rc_sensor_set_noise), "
+                 "which is applied to host buffers only");
     a = results->attributes;
     RC_RETURN_IF(ctx, a == 0, RC_ERR_INVALID_ARGUMENT, "results->attributes is 0: request at least one RC_ATTR_*");
     RC_RETURN_IF(ctx, (a & ~RC_ATTR_ALL) != 0, RC_ERR_INVALID_ARGUMENT,
@@ -76,7 +79,22 @@ poses_check:
     job.attributes = a;
     job.out = results;
     job.flags = results->flags;
-    return ctx->backend->simulate(ctx, &job);
+    RC_TRY(ctx->backend->simulate(ctx, &job));
+    if (sensor->noise.enabled) {
+        rc__noise_job nj;
+        nj.out = results;
+        nj.attributes = a;
+        nj.pose_count = pose_count;
+        nj.rays = sensor->rays;
+        nj.origins = sensor->origins;
+        nj.range_min = sensor->range_min;
+        nj.range_max = sensor->range_max;
+        rc__noise_apply(ctx->pool, &sensor->noise, &nj);
+        /* the next call draws fresh noise (the sensor is the context's, and
+         * a context is used by one thread at a time) */
+        ((rc_sensor *)sensor)->noise.draws++;
+    }
+    return RC_OK;
 }
 
 rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,

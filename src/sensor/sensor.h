@@ -4,6 +4,7 @@
 
 #include "core/context.h"
 #include "core/rmath.h"
+#include "noise/noise.h"
 
 struct rc_sensor {
     uint32_t magic;
@@ -22,6 +23,9 @@ struct rc_sensor {
     rc_spherical_desc spherical;
     rc_pinhole_desc pinhole;
     rc_cylindrical_desc cylindrical;
+    /* rc_sensor_set_noise; its draw count advances with each simulate (the
+     * one mutable field a simulate touches: contexts are single-threaded) */
+    rc__noise noise;
 };
 
 int rc__sensor_valid(const rc_sensor *sensor);
