@@ -592,6 +592,22 @@ class Sensor(_Child):
         return {"model": _MODELS.get(i.model, "unknown"), "rows": i.rows, "columns": i.columns,
                 "rays_per_scan": i.rays_per_scan, "range_min": i.range_min, "range_max": i.range_max}
 
+    def set_noise(self, sigma=0.0, mean=0.0, sigma_exponent=0.0, dropout=0.0, seed=0):
+        """Range noise and dropout for every later simulate with this sensor
+        (rc_sensor_set_noise): a return's range r becomes
+        r + mean + sigma * r**sigma_exponent * N(0, 1), clamped to the
+        sensor's range, its point moved along the ray; with probability
+        dropout it is lost instead. Reproducible: the n-th simulate after
+        set_noise draws the same numbers on every backend and thread count.
+        All zeros (the defaults) remove the noise."""
+        d = F.lib.rc_noise_desc_default()
+        d.mean, d.sigma, d.sigma_exponent, d.dropout = float(mean), float(sigma), float(sigma_exponent), float(dropout)
+        seed = int(seed)
+        if seed < 0 or seed > 0xFFFFFFFFFFFFFFFF:
+            raise Error(F.ERR_INVALID_ARGUMENT, "seed %d does not fit in uint64" % seed)
+        d.seed = seed
+        self._ctx._call("rc_sensor_set_noise", F.lib.rc_sensor_set_noise, self._handle(), ctypes.byref(d))
+
     def set_mounting(self, sensor_to_base):
         """Moves the sensor on the robot (7 numbers x y z qx qy qz qw)."""
         p = _pose(sensor_to_base)

@@ -157,6 +157,11 @@ class SensorInfo(ctypes.Structure):
                 ("reserved", c_u32 * 5)]
 
 
+class NoiseDesc(ctypes.Structure):
+    _fields_ = [("struct_size", c_u32), ("reserved0", c_u32), ("mean", c_float), ("sigma", c_float),
+                ("sigma_exponent", c_float), ("dropout", c_float), ("seed", c_u64), ("reserved", c_u32 * 8)]
+
+
 class Results(ctypes.Structure):
     _fields_ = [("struct_size", c_u32), ("attributes", c_u32), ("capacity", c_u64), ("hits", POINTER(c_u8)),
                 ("ranges", POINTER(c_float)), ("points", POINTER(c_float)), ("normals", POINTER(c_float)),
@@ -170,7 +175,7 @@ STRUCTS = {
     "rc_scene_desc": SceneDesc, "rc_mesh_desc": MeshDesc, "rc_instance_desc": InstanceDesc,
     "rc_scene_info": SceneInfo, "rc_sensor_common": SensorCommon, "rc_angle_axis": AngleAxis,
     "rc_spherical_desc": SphericalDesc, "rc_pinhole_desc": PinholeDesc, "rc_cylindrical_desc": CylindricalDesc,
-    "rc_rays_desc": RaysDesc, "rc_sensor_info": SensorInfo, "rc_results": Results,
+    "rc_rays_desc": RaysDesc, "rc_sensor_info": SensorInfo, "rc_noise_desc": NoiseDesc, "rc_results": Results,
 }
 
 _P = c_void_p  # opaque handles (rc_context *, rc_scene *, rc_sensor *)
@@ -220,6 +225,8 @@ _PROTOTYPES = {
     "rc_sensor_info_default": (SensorInfo, []),
     "rc_sensor_get_info": (c_i32, [_P, POINTER(SensorInfo)]),
     "rc_sensor_set_mounting": (c_i32, [_P, POINTER(Pose)]),
+    "rc_noise_desc_default": (NoiseDesc, []),
+    "rc_sensor_set_noise": (c_i32, [_P, POINTER(NoiseDesc)]),
     "rc_results_default": (Results, []),
     "rc_simulate": (c_i32, [_P, _P, _P, POINTER(Pose), c_u32, POINTER(Results)]),
     "rc_simulate_d": (c_i32, [_P, _P, _P, POINTER(PoseD), c_u32, POINTER(Results)]),

@@ -166,6 +166,34 @@ class TestAnalytic(Base):
         self.assertAlmostEqual(float(r), 4.0, places=5)
 
 
+class TestNoise(Base):
+    def test_noise_statistics_dropout_and_reproducibility(self):
+        scene = self.ctx.mesh_scene(*plane_x(20.0, half=500.0))
+        rng = np.random.default_rng(1)
+        dirs = np.concatenate([np.ones((20000, 1)), rng.uniform(-0.5, 0.5, (20000, 2))], axis=1)
+        s = self.ctx.rays_sensor(dirs, 0.1, 100.0)
+        clean = self.ctx.simulate(scene, s, IDENTITY)["ranges"]
+        s.set_noise(sigma=0.05, mean=0.01, seed=4)
+        a = self.ctx.simulate(scene, s, IDENTITY, ("ranges", "points"))
+        res = (a["ranges"] - clean).ravel()
+        self.assertLess(abs(res.mean() - 0.01), 5 * 0.05 / math.sqrt(res.size))
+        self.assertLess(abs(res.std() - 0.05), 0.0025)
+        np.testing.assert_allclose(np.linalg.norm(a["points"], axis=-1), a["ranges"], rtol=1e-5)
+        b = self.ctx.simulate(scene, s, IDENTITY)["ranges"]
+        self.assertFalse(np.array_equal(a["ranges"], b), "a second call drew the same noise")
+        s.set_noise(sigma=0.05, mean=0.01, seed=4)
+        np.testing.assert_array_equal(self.ctx.simulate(scene, s, IDENTITY)["ranges"], a["ranges"])
+        s.set_noise(dropout=0.25, seed=1)
+        hits = self.ctx.simulate(scene, s, IDENTITY, ("hits",))["hits"]
+        self.assertLess(abs(1.0 - hits.mean() - 0.25), 0.02)
+        s.set_noise()
+        np.testing.assert_array_equal(self.ctx.simulate(scene, s, IDENTITY)["ranges"], clean)
+        with self.assertRaises(Error) as cm:
+            s.set_noise(dropout=2.0)
+        self.assertEqual(cm.exception.status, F.ERR_INVALID_ARGUMENT)
+        self.assertIn("noise->dropout is 2", str(cm.exception))
+
+
 class TestScenes(Base):
     def test_instance_gives_transformed_answer(self):
         src = self.ctx.mesh_scene(*plane_x(1.0, half=0.5))
