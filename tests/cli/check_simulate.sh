@@ -42,6 +42,37 @@ awk 'f {
         exit bad
      }' centre.pcd || fail "centre.pcd contents"
 
+# Noise (rc_sensor_set_noise through --noise): the same scan with 5 cm of
+# range noise, point for point against the clean one (the residuals' mean near
+# 0 and deviation near 0.05, |point| still the range); the same seed gives
+# the same file, another seed another; dropout 0.1 keeps about 90% of the
+# returns.
+run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o noisy.pcd --ascii --fields range,ring --noise 0.05 \
+    --seed 3 $BACKEND
+sed -n '/^DATA/,$p' centre.pcd | tail -n +2 >clean.txt
+sed -n '/^DATA/,$p' noisy.pcd | tail -n +2 >noisy.txt
+paste -d ' ' clean.txt noisy.txt | awk '{
+        d = $9 - $4; n++; s += d; s2 += d * d
+        r = sqrt($6 * $6 + $7 * $7 + $8 * $8)
+        if (r - $9 > 1e-4 || $9 - r > 1e-4) { print "noisy |point| " r " vs range " $9; bad = 1 }
+     }
+     END {
+        m = s / n; sd = sqrt(s2 / n - m * m)
+        if (n != 14400 || m > 0.002 || m < -0.002 || sd < 0.047 || sd > 0.053) {
+            print "noise residuals: n " n " mean " m " sd " sd; bad = 1
+        }
+        exit bad
+     }' || fail "noisy.pcd against centre.pcd"
+run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o noisy2.pcd --ascii --fields range,ring --noise 0.05 \
+    --seed 3 $BACKEND
+cmp -s noisy.pcd noisy2.pcd || fail "the same seed gave another cloud"
+run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o noisy3.pcd --ascii --fields range,ring --noise 0.05 \
+    --seed 4 $BACKEND
+cmp -s noisy.pcd noisy3.pcd && fail "another seed gave the same cloud"
+run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o dropped.pcd --ascii --dropout 0.1 $BACKEND
+kept=$(sed -n 's/^POINTS //p' dropped.pcd)
+[ "$kept" -gt 12780 ] && [ "$kept" -lt 13140 ] || fail "dropout 0.1 kept $kept of 14400 returns"
+
 # The sensor turned 90 degrees about z (qz = qw = sqrt(1/2)) and moved: in the
 # map frame every point is still on the sphere.
 run 0 "" "$RC" simulate --map sphere.ply --pose 3,-2,1,0,0,0.70710678,0.70710678 --frame map -o moved.pcd \
@@ -145,6 +176,9 @@ run 2 "unknown sensor 'foo'" "$RC" simulate --map sphere.ply --pose 0,0,0 --sens
 run 2 "--pose" "$RC" simulate --map sphere.ply --pose 0,0,nan -o f.pcd
 run 2 "norm 0" "$RC" simulate --map sphere.ply --pose 0,0,0,0,0,0,0 -o g.pcd
 run 1 "no_dir" "$RC" simulate --map sphere.ply --pose 0,0,0 -o no_dir/h.pcd
+run 2 "noise->dropout is 1.5" "$RC" simulate --map sphere.ply --pose 0,0,0 -o i.pcd --dropout 1.5
+run 2 "noise->sigma is -1" "$RC" simulate --map sphere.ply --pose 0,0,0 -o j.pcd --noise -1
+run 2 "--seed: expected a decimal" "$RC" simulate --map sphere.ply --pose 0,0,0 -o k.pcd --seed -1
 # A write that fails (a full disk): exit 1 with the message; a device at the
 # path is left alone.
 if [ -c /dev/full ]; then
@@ -152,7 +186,7 @@ if [ -c /dev/full ]; then
     run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd
     [ -c /dev/full ] || fail "/dev/full was removed"
 fi
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
 done
 echo "check_simulate: all checks passed"

@@ -1,5 +1,6 @@
 /* rangecast simulate: a sensor at one or many poses in a mesh map -> a point
  * cloud of every return (and a range image of the first scan). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,6 +37,12 @@ static void usage(FILE *f)
         "  --fields LIST       extra per-point fields, comma-separated: range, intensity, ring\n"
         "  --image OUT.png     range image of the first scan (colour; inf black, -inf white)\n"
         "  --image-mode M      color (default) or gray16 (millimetres, 0 = no return)\n"
+        "  --noise SIGMA       Gaussian range noise, metres (rc_sensor_set_noise): a\n"
+        "                      return's range r becomes r + MEAN + SIGMA * r^K * N(0,1)\n"
+        "  --noise-mean MEAN   range bias, metres (default 0)\n"
+        "  --noise-exponent K  0 (default): constant; 1: grows with range; 2: stereo depth\n"
+        "  --dropout P         probability in [0, 1] that a return is lost\n"
+        "  --seed S            the noise's seed (default 0): the same seed, the same cloud\n"
         "  -h, --help          this text\n",
         rcp_mesh_formats());
 }
@@ -45,7 +52,29 @@ typedef struct sim_args {
     int have_pose, ascii, map_frame;
     rc_pose pose;
     uint32_t preset, backend, threads, fields, image_mode;
+    rc_noise_desc noise; /* all zero: none */
 } sim_args;
+
+/* A number for a noise option (its range is the library's to judge). */
+static int parse_noise_value(const char *cmd, const char *name, const char *v, float *out)
+{
+    if (rcp_parse_float(v, out) == 0) return 0;
+    rcp_usage_error(cmd, "%s: expected a number, got '%s'", name, v);
+    return -1;
+}
+
+/* A decimal uint64 and nothing else (no sign, no suffix). */
+static int parse_u64(const char *s, uint64_t *out)
+{
+    char *end = NULL;
+    unsigned long long v;
+    if (!s || *s < '0' || *s > '9') return -1;
+    errno = 0;
+    v = strtoull(s, &end, 10);
+    if (errno != 0 || *end != '\0') return -1;
+    *out = (uint64_t)v;
+    return 0;
+}
 
 static int parse_fields(const char *s, uint32_t *fields)
 {
@@ -68,6 +97,7 @@ static int parse_args(int argc, char **argv, sim_args *a)
     int i, r;
     memset(a, 0, sizeof *a);
     a->sensor_name = "vlp16";
+    a->noise = rc_noise_desc_default();
     for (i = 1; i < argc; i++) {
         const char *v = NULL;
         if (rcp_is_help(argv[i])) {
@@ -126,6 +156,18 @@ static int parse_args(int argc, char **argv, sim_args *a)
         } else if (OPT("--image")) {
             if (r < 0) return -1;
             a->image = v;
+        } else if (OPT("--noise")) {
+            if (r < 0 || parse_noise_value(cmd, "--noise", v, &a->noise.sigma) != 0) return -1;
+        } else if (OPT("--noise-mean")) {
+            if (r < 0 || parse_noise_value(cmd, "--noise-mean", v, &a->noise.mean) != 0) return -1;
+        } else if (OPT("--noise-exponent")) {
+            if (r < 0 || parse_noise_value(cmd, "--noise-exponent", v, &a->noise.sigma_exponent) != 0) return -1;
+        } else if (OPT("--dropout")) {
+            if (r < 0 || parse_noise_value(cmd, "--dropout", v, &a->noise.dropout) != 0) return -1;
+        } else if (OPT("--seed")) {
+            if (r < 0) return -1;
+            if (parse_u64(v, &a->noise.seed) != 0)
+                return rcp_usage_error(cmd, "--seed: expected a decimal number 0..2^64-1, got '%s'", v), -1;
         } else if (OPT("--image-mode")) {
             if (r < 0) return -1;
             if (strcmp(v, "color") == 0 || strcmp(v, "colour") == 0) a->image_mode = RCP_IMAGE_COLOR;
@@ -207,6 +249,15 @@ int rcp_cmd_simulate(int argc, char **argv)
         pose_count = 1;
     }
     if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) goto done;
+    {
+        /* the library judges the values: its message names the field */
+        const rc_status st = rc_sensor_set_noise(w.sensors[0], &a.noise);
+        if (st != RC_OK) {
+            rc = rcp_usage_error(cmd, "--noise/--noise-mean/--noise-exponent/--dropout: %s",
+                                 rc_context_last_error(w.ctx));
+            goto done;
+        }
+    }
     rc_sensor_get_info(w.sensors[0], &si);
     rays = si.rays_per_scan;
     if (rcu_preset_rays_f64(a.preset, &ref) != 0) {
