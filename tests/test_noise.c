@@ -202,12 +202,13 @@ static void test_same_calls_same_noise_everywhere(void **state)
     (void)state;
     assert_true(two_calls(RC_BACKEND_BVH, 1, &ref_a, &ref_b));
     n = (uint32_t)(ref_a.n / 2u);
-    /* each call, and each pose of a call, draws its own numbers */
+    /* each call, and each pose of a call, draws its own numbers (returns
+     * lost in both, +inf twice, do not count) */
     for (i = 0; i < n; ++i) {
-        same += ref_a.res.ranges[i] == ref_b.res.ranges[i];
-        same += ref_a.res.ranges[i] == ref_a.res.ranges[n + i];
+        same += isfinite(ref_a.res.ranges[i]) && ref_a.res.ranges[i] == ref_b.res.ranges[i];
+        same += isfinite(ref_a.res.ranges[i]) && ref_a.res.ranges[i] == ref_a.res.ranges[n + i];
     }
-    assert_true(same < n / 50u);
+    if (same > n / 100u) fail_msg("%u of %u noisy ranges repeat across calls or poses", same, 2u * n);
     for (bi = 0; bi < 3; ++bi) {
         const uint32_t threads = bi == 0 ? 3u : 2u;
         if (!two_calls(rct_backends[bi], threads, &a, &b)) continue;
