@@ -260,6 +260,80 @@ static void test_instance_bad_input(void **state)
     RCT_OK(f->ctx, rc_scene_destroy(top2));
 }
 
+/* Positions a million kilometres out and scales of 1e-7 or 1e7 are refused
+ * with a message, on every path that places a ray (Embree aborted the process
+ * on such rays: tests/test_fuzz_api.c found it); the bounds themselves pass. */
+static void test_reach_bounds(void **state)
+{
+    fixture *f = (fixture *)*state;
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    rc_instance_desc id = rc_instance_desc_default();
+    rc_rays_desc rd = rc_rays_desc_default();
+    rc_scene *s = NULL, *top = NULL;
+    rc_sensor *ondn = NULL;
+    rc_pose far = rct_pose(0.0f, 2.0e9f, 0.0f), near = rct_pose(0.0f, 0.0f, 0.0f);
+    rc_pose_d far_d = {{1.5e9, 0.0, 0.0}, {0.0, 0.0, 0.0, 1.0}};
+    rc_results r = f->buf.res;
+    float verts[9] = {0, 0, 0, 1, 0, 0, 0, 1, 2.0e9f};
+    const float dir[3] = {1.0f, 0.0f, 0.0f}, org_far[3] = {0.0f, 0.0f, -2.0e9f};
+    float edge[3] = {1.0e-6f, 1.0e6f, -1.0e6f}, tiny[3] = {1.0f, 1.0e-7f, 1.0f}, huge[3] = {1.0f, 1.0f, -1.0e7f};
+    uint32_t tri[3] = {0, 1, 2}, g = 0, inst = 0;
+    sd.max_triangles = 1;
+    RCT_OK(f->ctx, rc_scene_create(f->ctx, &sd, &s));
+    md.vertices = verts;
+    md.vertex_count = 3;
+    md.indices = tri;
+    md.triangle_count = 1;
+    EXPECT_FAIL(f, rc_scene_add_mesh(s, &md, &g), RC_ERR_INVALID_ARGUMENT, "vertices[2]");
+    verts[8] = 1.0e9f;
+    RCT_OK(f->ctx, rc_scene_add_mesh(s, &md, &g));
+    RCT_OK(f->ctx, rc_scene_commit(s));
+    verts[8] = -3.0e9f; /* a referenced mesh changed in place */
+    EXPECT_FAIL(f, rc_scene_update_mesh(s, 0), RC_ERR_INVALID_ARGUMENT, "vertex 2 of geometry 0");
+    verts[8] = 0.0f;
+
+    sd = rc_scene_desc_default();
+    sd.max_instances = 1;
+    RCT_OK(f->ctx, rc_scene_create(f->ctx, &sd, &top));
+    id.source = f->scene;
+    id.transform = far;
+    EXPECT_FAIL(f, rc_scene_add_instance(top, &id, &inst), RC_ERR_INVALID_ARGUMENT, "transform.position");
+    id.transform = near;
+    memcpy(id.scale, tiny, sizeof tiny);
+    EXPECT_FAIL(f, rc_scene_add_instance(top, &id, &inst), RC_ERR_INVALID_ARGUMENT, "scale[1]");
+    memcpy(id.scale, huge, sizeof huge);
+    EXPECT_FAIL(f, rc_scene_add_instance(top, &id, &inst), RC_ERR_INVALID_ARGUMENT, "scale[2]");
+    memcpy(id.scale, edge, sizeof edge);
+    RCT_OK(f->ctx, rc_scene_add_instance(top, &id, &inst));
+    EXPECT_FAIL(f, rc_scene_set_instance_transform(top, 0, &near, tiny), RC_ERR_INVALID_ARGUMENT, "scale[1]");
+    EXPECT_FAIL(f, rc_scene_set_instance_transform(top, 0, &far, NULL), RC_ERR_INVALID_ARGUMENT, "position");
+    RCT_OK(f->ctx, rc_scene_commit(top));
+
+    rd.common.range_min = 0.1f;
+    rd.common.range_max = 10.0f;
+    rd.directions = dir;
+    rd.origins = org_far;
+    rd.ray_count = 1;
+    EXPECT_FAIL(f, rc_sensor_create_rays(f->ctx, RC_SENSOR_ONDN, &rd, &ondn), RC_ERR_INVALID_ARGUMENT, "origins[0]");
+    assert_null(ondn);
+
+    /* poses: the sensor (mounting included) within 1e9 m of the scene origin */
+    EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, &far, 1, &r), RC_ERR_INVALID_ARGUMENT, "poses[0]");
+    EXPECT_FAIL(f, rc_simulate_d(f->ctx, f->scene, f->sensor, &far_d, 1, &r), RC_ERR_INVALID_ARGUMENT, "poses[0]");
+    {
+        rc_pose mount = rct_pose(0.0f, 0.0f, 9.9e8f);
+        rc_pose up = rct_pose(0.0f, 0.0f, 2.0e7f);
+        RCT_OK(f->ctx, rc_sensor_set_mounting(f->sensor, &mount));
+        EXPECT_FAIL(f, rc_simulate(f->ctx, f->scene, f->sensor, &up, 1, &r), RC_ERR_INVALID_ARGUMENT,
+                    "mounting included");
+        mount = rc_pose_identity();
+        RCT_OK(f->ctx, rc_sensor_set_mounting(f->sensor, &mount));
+    }
+    RCT_OK(f->ctx, rc_scene_destroy(top));
+    RCT_OK(f->ctx, rc_scene_destroy(s));
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -267,6 +341,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_mesh_bad_input, setup, teardown),
         cmocka_unit_test_setup_teardown(test_scene_desc_bad_input, setup, teardown),
         cmocka_unit_test_setup_teardown(test_instance_bad_input, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_reach_bounds, setup, teardown),
     };
     return cmocka_run_group_tests_name("bad input", tests, NULL, NULL);
 }

@@ -351,14 +351,15 @@ typedef struct rc_mesh_desc {
 RC_API rc_mesh_desc rc_mesh_desc_default(void);
 
 /* Adds a triangle mesh. Checks every vertex is finite (RC_ERR_NON_FINITE) and
- * every index is < vertex_count (RC_ERR_OUT_OF_RANGE) and zero counts
- * (RC_ERR_INVALID_ARGUMENT). *geom_id is its geometry id in this scene
+ * within 1e9 m of the scene's origin on each axis, every index is <
+ * vertex_count (RC_ERR_OUT_OF_RANGE) and zero counts (RC_ERR_INVALID_ARGUMENT). *geom_id is its geometry id in this scene
  * (0, 1, 2 ... in order of adding). The scene must be committed afterwards.
  * Degenerate (zero-area) triangles are allowed and never hit. */
 RC_API rc_status rc_scene_add_mesh(rc_scene *scene, const rc_mesh_desc *desc, uint32_t *geom_id);
 
 /* Tells the scene a referenced mesh's vertices changed (same counts). The next
- * commit refits that mesh's BVH instead of rebuilding it. */
+ * commit refits that mesh's BVH instead of rebuilding it. The vertices are
+ * checked again as rc_scene_add_mesh checks them. */
 RC_API rc_status rc_scene_update_mesh(rc_scene *scene, uint32_t geom_id);
 
 /* An instance places another scene (holding meshes only, committed) in this one. */
@@ -374,10 +375,14 @@ typedef struct rc_instance_desc {
 RC_API rc_instance_desc rc_instance_desc_default(void);
 
 /* Adds an instance; *inst_id is its id (0, 1, 2 ... in order). Scale must be
- * non-zero and finite in every axis once set. */
+ * finite with a magnitude in [1e-6, 1e6] in every axis once set (negative
+ * mirrors), and the translation within 1e9 m of the scene's origin on each
+ * axis: RC_ERR_INVALID_ARGUMENT otherwise. (Outside those a ray in the
+ * instance's frame starts where Embree no longer traces it.) */
 RC_API rc_status rc_scene_add_instance(rc_scene *scene, const rc_instance_desc *desc, uint32_t *inst_id);
 /* Moves an instance (dynamic maps); takes effect at the next commit, which only
- * rebuilds the top level. */
+ * rebuilds the top level. The transform and scale are checked as in
+ * rc_scene_add_instance. */
 RC_API rc_status rc_scene_set_instance_transform(rc_scene *scene, uint32_t inst_id,
                                                  const rc_pose *transform, const float scale[3]);
 
@@ -487,7 +492,8 @@ typedef struct rc_cylindrical_desc {
  * OnDn: a ray origin per direction too (sensor frame). Directions need not be
  * unit: they are normalised (a zero direction is RC_ERR_INVALID_ARGUMENT).
  * width * height = ray_count lets tools show the scan as an image; 0, 0 means
- * (ray_count, 1). The arrays are copied into the arena at create. */
+ * (ray_count, 1). Origins lie within 1e9 m of the sensor on each axis. The
+ * arrays are copied into the arena at create. */
 typedef struct rc_rays_desc {
     uint32_t struct_size;
     uint32_t reserved0;
@@ -686,7 +692,9 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * (RC_ERR_NOT_COMMITTED), pose_count 0 or a missing buffer
  * (RC_ERR_INVALID_ARGUMENT), capacity too small (RC_ERR_CAPACITY), a NaN/inf
  * pose or a quaternion whose norm is not within 1e-3 of 1 (RC_ERR_NON_FINITE /
- * RC_ERR_INVALID_ARGUMENT; near-unit ones are normalised). Runs on the context's
+ * RC_ERR_INVALID_ARGUMENT; near-unit ones are normalised), a pose that puts
+ * the sensor (mounting included) more than 1e9 m from the scene's origin on
+ * an axis (RC_ERR_INVALID_ARGUMENT). Runs on the context's
  * threads; results are bit-identical for any thread count. No allocation. */
 RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
                              const rc_pose *poses, uint32_t pose_count, const rc_results *results);

@@ -152,6 +152,10 @@ static rc_status check_mesh(rc_context *ctx, const rc_mesh_desc *d)
         const float *v = d->vertices + i * (stride / 4u);
         RC_RETURN_IF(ctx, !rc__all_finite(v, 3), RC_ERR_NON_FINITE, "desc->vertices[%llu] is (%g, %g, %g): not finite",
                      (unsigned long long)i, (double)v[0], (double)v[1], (double)v[2]);
+        RC_RETURN_IF(ctx, !rc__in_reach3(v), RC_ERR_INVALID_ARGUMENT,
+                     "desc->vertices[%llu] is (%g, %g, %g): farther than %g m from the scene's origin "
+                     "(rc_scene_desc.origin)",
+                     (unsigned long long)i, (double)v[0], (double)v[1], (double)v[2], RC__MAX_COORD);
     }
     for (i = 0; i < d->triangle_count * 3u; ++i)
         RC_RETURN_IF(ctx, d->indices[i] >= d->vertex_count, RC_ERR_OUT_OF_RANGE,
@@ -232,6 +236,9 @@ rc_status rc_scene_update_mesh(rc_scene *scene, uint32_t geom_id)
         const float *v = g->mesh.vertices + (size_t)i * g->mesh.stride;
         RC_RETURN_IF(ctx, !rc__all_finite(v, 3), RC_ERR_NON_FINITE, "vertex %u of geometry %u is not finite",
                      (unsigned)i, (unsigned)geom_id);
+        RC_RETURN_IF(ctx, !rc__in_reach3(v), RC_ERR_INVALID_ARGUMENT,
+                     "vertex %u of geometry %u is (%g, %g, %g): farther than %g m from the scene's origin",
+                     (unsigned)i, (unsigned)geom_id, (double)v[0], (double)v[1], (double)v[2], RC__MAX_COORD);
     }
     if (g->dirty == 0) g->dirty = 2;
     scene->committed = 0;
@@ -245,6 +252,9 @@ static rc_status check_instance_pose(rc_context *ctx, const rc_pose *pose, const
     int i;
     RC_RETURN_IF(ctx, st == RC_ERR_NON_FINITE, st, "transform has a NaN or infinite value");
     RC_RETURN_IF(ctx, st != RC_OK, st, "transform.orientation is not a unit quaternion (norm off by more than 1e-3)");
+    RC_RETURN_IF(ctx, !rc__in_reach3(pose->position), RC_ERR_INVALID_ARGUMENT,
+                 "transform.position is (%g, %g, %g): farther than %g m from the scene's origin",
+                 (double)pose->position[0], (double)pose->position[1], (double)pose->position[2], RC__MAX_COORD);
     if (scale[0] == 0.0f && scale[1] == 0.0f && scale[2] == 0.0f) {
         out[0] = out[1] = out[2] = 1.0f;
         return RC_OK;
@@ -252,6 +262,9 @@ static rc_status check_instance_pose(rc_context *ctx, const rc_pose *pose, const
     for (i = 0; i < 3; ++i) {
         RC_RETURN_IF(ctx, !isfinite(scale[i]), RC_ERR_NON_FINITE, "scale[%d] is not finite", i);
         RC_RETURN_IF(ctx, scale[i] == 0.0f, RC_ERR_INVALID_ARGUMENT, "scale[%d] is 0", i);
+        RC_RETURN_IF(ctx, !(fabsf(scale[i]) >= (float)RC__MIN_SCALE && fabsf(scale[i]) <= (float)RC__MAX_SCALE),
+                     RC_ERR_INVALID_ARGUMENT, "scale[%d] is %g; its magnitude must lie in [%g, %g]", i,
+                     (double)scale[i], RC__MIN_SCALE, RC__MAX_SCALE);
         out[i] = scale[i];
     }
     return RC_OK;

@@ -18,6 +18,27 @@ static rc_status check_buffer(rc_context *ctx, uint32_t attributes, uint32_t bit
     return RC_OK;
 }
 
+/* 1 when pose i puts the sensor (mounting included) within RC__MAX_COORD of
+ * the scene's origin on every axis. */
+static int sensor_in_reach(const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
+                           const rc_pose_d *poses_d, uint32_t i, double *far)
+{
+    rc__xform base, world;
+    uint32_t k;
+    if (poses_d) {
+        rc__xform_from_pose_d(&poses_d[i], &base);
+    } else {
+        rc__xform_from_pose(&poses[i], &base);
+    }
+    rc__xform_mul(&base, &sensor->mount_xform, &world);
+    *far = 0.0;
+    for (k = 0; k < 3; ++k) {
+        const double d = fabs(world.t[k] - scene->desc.origin[k]);
+        if (!(d <= *far)) *far = d; /* NaN stays: it is not in reach */
+    }
+    return *far <= RC__MAX_COORD;
+}
+
 static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
                          const rc_pose_d *poses_d, uint32_t pose_count, const rc_results *results)
 {
@@ -70,6 +91,13 @@ poses_check:
                      "poses[%u].orientation is not a unit quaternion (|q| = 1 within 1e-3 is normalised; "
                      "farther off is rejected)",
                      (unsigned)i);
+    }
+    for (i = 0; i < pose_count; ++i) {
+        double far;
+        RC_RETURN_IF(ctx, !sensor_in_reach(scene, sensor, poses, poses_d, i, &far), RC_ERR_INVALID_ARGUMENT,
+                     "poses[%u] puts the sensor %g m from the scene's origin (mounting included); rays start "
+                     "at most %g m from it",
+                     (unsigned)i, far, RC__MAX_COORD);
     }
     job.scene = scene;
     job.sensor = sensor;

@@ -22,6 +22,25 @@ typedef struct rc__xformf {
     double td[3];
 } rc__xformf;
 
+/* Bounds that keep every ray a backend sees valid. Per axis, in metres:
+ * vertices (from their scene's origin), instance translations, a sensor
+ * placed by a pose (mounting included, from the scene's origin) and an OnDn
+ * ray's origin (in its sensor frame) lie within RC__MAX_COORD; instance
+ * scales lie within [RC__MIN_SCALE, RC__MAX_SCALE] in magnitude. Embree takes
+ * a ray that starts past 1.8e18, in the world or in an instance's frame, as
+ * invalid (its assertions abort the process: a scale of 1e-30 did that); with
+ * these a ray starts within about 4e15 in any frame, and float positions a
+ * million kilometres out mean nothing anyway. */
+#define RC__MAX_COORD 1.0e9
+#define RC__MIN_SCALE 1.0e-6
+#define RC__MAX_SCALE 1.0e6
+
+static inline int rc__in_reach3(const float v[3])
+{
+    return fabsf(v[0]) <= (float)RC__MAX_COORD && fabsf(v[1]) <= (float)RC__MAX_COORD &&
+           fabsf(v[2]) <= (float)RC__MAX_COORD;
+}
+
 /* Checks a pose: finite, quaternion norm within 1e-3 of 1. Returns RC_OK,
  * RC_ERR_NON_FINITE or RC_ERR_INVALID_ARGUMENT (norm off). */
 rc_status rc__pose_check(const rc_pose *pose);

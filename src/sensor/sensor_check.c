@@ -177,6 +177,10 @@ rc_status rc__sensor_check_rays(rc_context *ctx, uint32_t model, const rc_rays_d
             if (!rc__all_finite(o, 3))
                 return rc__fail(ctx, RC_ERR_NON_FINITE, "desc.origins[%u] is (%g, %g, %g): must be finite", i,
                                 (double)o[0], (double)o[1], (double)o[2]);
+            if (!rc__in_reach3(o))
+                return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT,
+                                "desc.origins[%u] is (%g, %g, %g): farther than %g m from the sensor", i,
+                                (double)o[0], (double)o[1], (double)o[2], RC__MAX_COORD);
         }
     }
     return RC_OK;
