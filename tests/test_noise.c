@@ -269,6 +269,13 @@ static void test_noise_stays_in_range_and_off_is_off(void **state)
         assert_int_equal(out.res.hits[i], 1);
         assert_true(out.res.ranges[i] >= 0.5f && out.res.ranges[i] <= 100.0f);
     }
+    /* absurd noise: every range clamped, none NaN */
+    set_noise(&f, 0.0f, 3.0e38f, 4.0f, 0.0f, 2);
+    run(&f, 1, &out);
+    for (i = 0; i < f.n; ++i) {
+        assert_int_equal(out.res.hits[i], 1);
+        assert_true(out.res.ranges[i] == 0.5f || out.res.ranges[i] == 100.0f);
+    }
     /* all-zero noise and NULL both switch it off: the clean bits again */
     zero.seed = 99;
     RCT_OK(f.ctx, rc_sensor_set_noise(f.sensor, &zero));

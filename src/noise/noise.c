@@ -106,7 +106,7 @@ static void move(const noise_run *run, uint64_t k, uint32_t ray)
     const rc_results *out = job->out;
     const float *org = job->origins ? job->origins + 3u * ray : NULL;
     float *p = (job->attributes & RC_ATTR_POINTS) ? out->points + 3u * k : NULL;
-    double r, scale, moved;
+    double r, scale, spread, moved;
     uint32_t i;
     if (job->attributes & RC_ATTR_RANGES) {
         r = out->ranges[k];
@@ -121,7 +121,12 @@ static void move(const noise_run *run, uint64_t k, uint32_t ray)
         return; /* neither ranges nor points: nothing shows the range */
     }
     scale = nz->exponent == 0.0f ? 1.0 : nz->exponent == 1.0f ? r : pow(r, (double)nz->exponent);
-    moved = r + (double)nz->mean + (double)nz->sigma * scale * rc__noise_normal(run->key, 3u * k);
+    spread = (double)nz->sigma * scale * rc__noise_normal(run->key, 3u * k);
+    /* an infinite sigma * r^k times a variate of exactly 0 (u1 rounds to 1
+     * in float about once in 3e7 draws) is NaN: no spread then; an infinite
+     * spread is clamped below like any other */
+    if (spread != spread) spread = 0.0;
+    moved = r + (double)nz->mean + spread;
     if (moved < (double)job->range_min) moved = job->range_min;
     if (moved > (double)job->range_max) moved = job->range_max;
     if (job->attributes & RC_ATTR_RANGES) out->ranges[k] = (float)moved;
