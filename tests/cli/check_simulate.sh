@@ -73,6 +73,17 @@ run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o dropped.pcd --ascii --d
 kept=$(sed -n 's/^POINTS //p' dropped.pcd)
 [ "$kept" -gt 12780 ] && [ "$kept" -lt 13140 ] || fail "dropout 0.1 kept $kept of 14400 returns"
 
+# A commit's progress shows on a terminal only: none in these logs; through
+# script(1), which gives the program a terminal, a large map's build counts
+# to 100%.
+grep -q "build" err.txt && fail "progress printed to a log"
+if command -v script >/dev/null 2>&1; then
+    run 0 "" "$RC" gen --sphere 600k -o big.ply
+    script -qc "'$RC' simulate --map big.ply --pose 0,0,0 -o big_scan.ply $BACKEND" /dev/null >tty.txt 2>&1 ||
+        { cat tty.txt >&2; fail "simulate on a terminal"; }
+    grep -q "build 100%" tty.txt || { cat tty.txt >&2; fail "no progress on a terminal"; }
+fi
+
 # The sensor turned 90 degrees about z (qz = qw = sqrt(1/2)) and moved: in the
 # map frame every point is still on the sphere.
 run 0 "" "$RC" simulate --map sphere.ply --pose 3,-2,1,0,0,0.70710678,0.70710678 --frame map -o moved.pcd \
@@ -176,6 +187,11 @@ run 2 "unknown sensor 'foo'" "$RC" simulate --map sphere.ply --pose 0,0,0 --sens
 run 2 "--pose" "$RC" simulate --map sphere.ply --pose 0,0,nan -o f.pcd
 run 2 "norm 0" "$RC" simulate --map sphere.ply --pose 0,0,0,0,0,0,0 -o g.pcd
 run 1 "no_dir" "$RC" simulate --map sphere.ply --pose 0,0,0 -o no_dir/h.pcd
+# a context the library refuses: its own reason, not just the status
+if "$RC" help | grep -q "Backends in this library:.*vulkan"; then
+    RANGECAST_VULKAN_DEVICE=no-such-gpu run 1 "rc_context_create failed: RC_ERR_UNSUPPORTED.*: vulkan" \
+        "$RC" simulate --map sphere.ply --pose 0,0,0 -o l.pcd --backend vulkan
+fi
 run 2 "noise->dropout is 1.5" "$RC" simulate --map sphere.ply --pose 0,0,0 -o i.pcd --dropout 1.5
 run 2 "noise->sigma is -1" "$RC" simulate --map sphere.ply --pose 0,0,0 -o j.pcd --noise -1
 run 2 "--seed: expected a decimal" "$RC" simulate --map sphere.ply --pose 0,0,0 -o k.pcd --seed -1
@@ -186,7 +202,7 @@ if [ -c /dev/full ]; then
     run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd
     [ -c /dev/full ] || fail "/dev/full was removed"
 fi
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
 done
 echo "check_simulate: all checks passed"

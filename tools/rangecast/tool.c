@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "util.h"
 
@@ -41,6 +42,17 @@ int rcp_lib_error(const char *cmd, const rc_context *ctx, const char *call, rc_s
     const char *detail = ctx ? rc_context_last_error(ctx) : "";
     return rcp_fail(cmd, "%s failed: %s%s%s", call, rc_status_string(st), detail && *detail ? ": " : "",
                     detail ? detail : "");
+}
+
+/* The library's log: warnings go to stderr; errors come back as a status +
+ * rc_context_last_error and are printed there, except a failed
+ * rc_context_create's, which only the log sees: it is kept in user (a buffer
+ * of RCP_LOG_TEXT bytes) for the caller to print. */
+#define RCP_LOG_TEXT 512
+static void log_to_stderr(void *user, uint32_t level, const char *message)
+{
+    if (level == RC_LOG_WARN) fprintf(stderr, "rangecast: library warning: %s\n", message);
+    if (level == RC_LOG_ERROR && user) snprintf((char *)user, RCP_LOG_TEXT, "%s", message);
 }
 
 int rcp_is_help(const char *arg)
@@ -230,14 +242,19 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
          * one (one thread, an arena of just its own size) to ask it. */
         rc_context_desc pd = cd;
         rc_context *probe = NULL;
+        static char probe_error[RCP_LOG_TEXT];
         rc_scene_desc sd = scene_desc_for(mesh);
         size_t probe_bytes = 0;
         pd.thread_count = 1;
         if ((st = rc_context_memory_requirements(&pd, &probe_bytes)) != RC_OK)
             return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
         pd.memory_size = probe_bytes;
+        pd.log = log_to_stderr;
+        pd.log_user = probe_error;
+        probe_error[0] = '\0';
         if ((st = rc_context_create(&pd, &probe)) != RC_OK)
-            return rcp_lib_error(cmd, NULL, "rc_context_create (sizing probe)", st);
+            return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), probe_error[0] ? ": " : "",
+                            probe_error);
         st = rc_scene_memory_requirements(probe, &sd, &sb);
         if (st != RC_OK) {
             rcp_lib_error(cmd, probe, "rc_scene_memory_requirements", st);
@@ -258,12 +275,32 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
     return RCP_EXIT_OK;
 }
 
-static void log_to_stderr(void *user, uint32_t level, const char *message)
+/* A commit's progress on a terminal: "rangecast CMD: bvh build 42%" rewritten
+ * in place, a line per stage. Off when stderr is not a terminal (logs, CI)
+ * and for maps that build in a blink. */
+#define RCP_PROGRESS_MIN_TRIANGLES 500000u
+typedef struct commit_progress {
+    const char *cmd;
+    char stage[32];
+    int percent;
+} commit_progress;
+
+static int show_progress(void *user, const char *stage, double fraction)
 {
-    (void)user;
-    /* errors come back as a status + rc_context_last_error and are printed
-     * there; warnings have no other way out */
-    if (level == RC_LOG_WARN) fprintf(stderr, "rangecast: library warning: %s\n", message);
+    commit_progress *p = (commit_progress *)user;
+    const int percent = (int)(fraction * 100.0 + 0.5);
+    if (strcmp(stage, p->stage) != 0) {
+        if (fraction >= 1.0) return 1; /* a stage that starts done is only a marker ("commit") */
+        if (p->stage[0] && p->percent < 100) fputc('\n', stderr);
+        snprintf(p->stage, sizeof p->stage, "%s", stage);
+        p->percent = -1;
+    }
+    if (percent == p->percent) return 1;
+    p->percent = percent;
+    fprintf(stderr, "\rrangecast %s: %s %3d%%", p->cmd, stage, percent);
+    if (percent >= 100) fputc('\n', stderr);
+    fflush(stderr);
+    return 1;
 }
 
 void rcp_world_destroy(rcp_world *world)
@@ -307,6 +344,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     rc_status st;
     uint32_t k;
     const char *call;
+    static char create_error[RCP_LOG_TEXT];
     memset(w, 0, sizeof *w);
     if (preset_count > RCP_MAX_SENSORS) return rcp_fail(cmd, "too many sensors");
     if (rcp_arena_bytes(cmd, backend, threads, mesh, presets, preset_count, &w->arena_bytes,
@@ -323,8 +361,11 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     cd.memory = NULL;             /* the library mallocs exactly this much, once */
     cd.memory_size = w->arena_bytes;
     cd.log = log_to_stderr;
+    cd.log_user = create_error;
+    create_error[0] = '\0';
     if ((st = rc_context_create(&cd, &w->ctx)) != RC_OK)
-        return rcp_lib_error(cmd, NULL, "rc_context_create", st);
+        return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), create_error[0] ? ": " : "",
+                        create_error);
     rc_context_get_backend(w->ctx, &w->backend);
     rc_context_get_thread_count(w->ctx, &w->threads);
     if (mesh) {
@@ -343,7 +384,16 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
         if ((st = rc_scene_add_mesh(w->scene, &md, &geom)) != RC_OK) goto fail;
         call = "rc_scene_commit";
         t0 = rcu_now();
-        if ((st = rc_scene_commit(w->scene)) != RC_OK) goto fail;
+        if (mesh->triangle_count >= RCP_PROGRESS_MIN_TRIANGLES && isatty(STDERR_FILENO)) {
+            commit_progress p;
+            memset(&p, 0, sizeof p);
+            p.cmd = cmd;
+            st = rc_scene_commit_with_progress(w->scene, show_progress, &p);
+            if (p.stage[0] && p.percent < 100) fputc('\n', stderr);
+        } else {
+            st = rc_scene_commit(w->scene);
+        }
+        if (st != RC_OK) goto fail;
         w->build_s = rcu_now() - t0;
     }
     call = "rc_sensor_create_preset";
