@@ -202,7 +202,15 @@ if [ -c /dev/full ]; then
     run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd
     [ -c /dev/full ] || fail "/dev/full was removed"
 fi
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd; do
+# A write that fails halfway (the file size limit, with SIGXFSZ ignored so
+# the write returns EFBIG): exit 1 and no half-written file left behind.
+limited() {
+    (trap '' XFSZ; ulimit -f 8; exec "$@")
+}
+run 1 "m.ply: write error" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o m.ply
+run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --ranges-out n.bin \
+    $BACKEND
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
 done
 echo "check_simulate: all checks passed"

@@ -361,6 +361,7 @@ int rcp_cmd_bench(int argc, char **argv)
     uint32_t last_batch_start;
     accuracy acc;
     FILE *rout = NULL;
+    int rout_opened = 0;
     rc_status st;
     int rc = RCP_EXIT_FAIL, is_sphere;
 
@@ -503,6 +504,7 @@ int rcp_cmd_bench(int argc, char **argv)
         rcp_fail(cmd, "%s: cannot open for writing", a.ranges_out);
         goto done;
     }
+    rout_opened = rout != NULL;
     {
         rc_results res = rc_results_default();
         rcu_xform mount;
@@ -659,6 +661,8 @@ int rcp_cmd_bench(int argc, char **argv)
 done:
     free(ondn);
     if (rout) fclose(rout);
+    /* a failed run leaves no half-written ranges behind */
+    if (rc != RCP_EXIT_OK && a.ranges_out && rout_opened) rcu_remove_partial(a.ranges_out);
     rcp_world_destroy(&w);
     rcu_preset_rays_free(&ref);
     free(acc.errs);
