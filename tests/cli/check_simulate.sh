@@ -208,9 +208,11 @@ limited() {
     (trap '' XFSZ; ulimit -f 8; exec "$@")
 }
 run 1 "m.ply: write error" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o m.ply
+run 1 "o.p" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o o.ply --image o.png
+[ ! -e o.png ] && [ ! -e o.ppm ] || fail "a half-written range image was left behind"
 run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --ranges-out n.bin \
     $BACKEND
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
 done
 echo "check_simulate: all checks passed"

@@ -110,7 +110,10 @@ static int write_pixels(const char *path, unsigned char *pix, uint32_t w, uint32
         }
     if (fwrite(pix, gray ? 2 : 3, n, f) != n) st = -1;
     if (fclose(f) != 0) st = -1;
-    if (st != 0) rcu_fail("%s: write error", out_path);
+    if (st != 0) {
+        rcu_remove_partial(out_path); /* libpng's writer does the same */
+        rcu_fail("%s: write error", out_path);
+    }
 #endif
     if (st == 0 && written) snprintf(written, written_size, "%s", out_path);
     return st;
