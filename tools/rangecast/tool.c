@@ -285,13 +285,23 @@ typedef struct commit_progress {
     int percent;
 } commit_progress;
 
+/* Ends the stage on the line: 100% when the work it measured is done (a
+ * builder's last report can fall short of 1, or come as the next stage). */
+static void finish_stage(commit_progress *p, int done)
+{
+    if (!p->stage[0] || p->percent >= 100) return;
+    if (done) fprintf(stderr, "\rrangecast %s: %s 100%%", p->cmd, p->stage);
+    fputc('\n', stderr);
+    p->percent = 100;
+}
+
 static int show_progress(void *user, const char *stage, double fraction)
 {
     commit_progress *p = (commit_progress *)user;
     const int percent = (int)(fraction * 100.0 + 0.5);
     if (strcmp(stage, p->stage) != 0) {
+        finish_stage(p, 1); /* a new stage: the one before is over */
         if (fraction >= 1.0) return 1; /* a stage that starts done is only a marker ("commit") */
-        if (p->stage[0] && p->percent < 100) fputc('\n', stderr);
         snprintf(p->stage, sizeof p->stage, "%s", stage);
         p->percent = -1;
     }
@@ -389,7 +399,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
             memset(&p, 0, sizeof p);
             p.cmd = cmd;
             st = rc_scene_commit_with_progress(w->scene, show_progress, &p);
-            if (p.stage[0] && p.percent < 100) fputc('\n', stderr);
+            finish_stage(&p, st == RC_OK);
         } else {
             st = rc_scene_commit(w->scene);
         }
