@@ -46,8 +46,9 @@
  * - Frames: right-handed, x forward, y left, z up (REP 103) unless a field says
  *   otherwise. Quaternions are (x, y, z, w). Lengths in metres, angles in radians.
  * - Thread rules: a context, and everything created from it, is used by one
- *   thread at a time, unless a function says otherwise. Functions without a
- *   context argument are thread-safe.
+ *   thread at a time, unless a function says otherwise. Separate contexts may
+ *   be used on separate threads at the same time (one per filter or core).
+ *   Functions without a context argument are thread-safe.
  * - Memory tiers: with the built-in BVH backend the library allocates only inside
  *   the context's arena (a block the caller hands in, or one malloc at context
  *   creation), and never after rc_context_create. The Embree and Vulkan backends
