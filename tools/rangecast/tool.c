@@ -55,6 +55,20 @@ static void log_to_stderr(void *user, uint32_t level, const char *message)
     if (level == RC_LOG_ERROR && user) snprintf((char *)user, RCP_LOG_TEXT, "%s", message);
 }
 
+/* rc_context_create with the log above; a refusal prints the library's
+ * reason, which only the log sees. The buffer is static: the context keeps
+ * log_user for its whole life (the program is single-threaded). */
+static int create_context(const char *cmd, rc_context_desc *desc, rc_context **out)
+{
+    static char why[RCP_LOG_TEXT];
+    rc_status st;
+    desc->log = log_to_stderr;
+    desc->log_user = why;
+    why[0] = '\0';
+    if ((st = rc_context_create(desc, out)) == RC_OK) return RCP_EXIT_OK;
+    return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), why[0] ? ": " : "", why);
+}
+
 int rcp_is_help(const char *arg)
 {
     return strcmp(arg, "--help") == 0 || strcmp(arg, "-h") == 0;
@@ -242,19 +256,13 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
          * one (one thread, an arena of just its own size) to ask it. */
         rc_context_desc pd = cd;
         rc_context *probe = NULL;
-        static char probe_error[RCP_LOG_TEXT];
         rc_scene_desc sd = scene_desc_for(mesh);
         size_t probe_bytes = 0;
         pd.thread_count = 1;
         if ((st = rc_context_memory_requirements(&pd, &probe_bytes)) != RC_OK)
             return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
         pd.memory_size = probe_bytes;
-        pd.log = log_to_stderr;
-        pd.log_user = probe_error;
-        probe_error[0] = '\0';
-        if ((st = rc_context_create(&pd, &probe)) != RC_OK)
-            return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), probe_error[0] ? ": " : "",
-                            probe_error);
+        if (create_context(cmd, &pd, &probe) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
         st = rc_scene_memory_requirements(probe, &sd, &sb);
         if (st != RC_OK) {
             rcp_lib_error(cmd, probe, "rc_scene_memory_requirements", st);
@@ -354,7 +362,6 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     rc_status st;
     uint32_t k;
     const char *call;
-    static char create_error[RCP_LOG_TEXT];
     memset(w, 0, sizeof *w);
     if (preset_count > RCP_MAX_SENSORS) return rcp_fail(cmd, "too many sensors");
     if (rcp_arena_bytes(cmd, backend, threads, mesh, presets, preset_count, &w->arena_bytes,
@@ -370,12 +377,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     cd.thread_count = threads;
     cd.memory = NULL;             /* the library mallocs exactly this much, once */
     cd.memory_size = w->arena_bytes;
-    cd.log = log_to_stderr;
-    cd.log_user = create_error;
-    create_error[0] = '\0';
-    if ((st = rc_context_create(&cd, &w->ctx)) != RC_OK)
-        return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), create_error[0] ? ": " : "",
-                        create_error);
+    if (create_context(cmd, &cd, &w->ctx) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
     rc_context_get_backend(w->ctx, &w->backend);
     rc_context_get_thread_count(w->ctx, &w->threads);
     if (mesh) {
