@@ -86,14 +86,12 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
 poses_check:
     for (i = 0; i < pose_count; ++i) {
         rc_status st = poses ? rc__pose_check(&poses[i]) : rc__pose_check_d(&poses_d[i]);
+        double far;
         RC_RETURN_IF(ctx, st == RC_ERR_NON_FINITE, st, "poses[%u] has a NaN or infinite value", (unsigned)i);
         RC_RETURN_IF(ctx, st != RC_OK, st,
                      "poses[%u].orientation is not a unit quaternion (|q| = 1 within 1e-3 is normalised; "
                      "farther off is rejected)",
                      (unsigned)i);
-    }
-    for (i = 0; i < pose_count; ++i) {
-        double far;
         RC_RETURN_IF(ctx, !sensor_in_reach(scene, sensor, poses, poses_d, i, &far), RC_ERR_INVALID_ARGUMENT,
                      "poses[%u] puts the sensor %g m from the scene's origin (mounting included); rays start "
                      "at most %g m from it",
