@@ -312,9 +312,32 @@ static void test_attribute_subsets(void **state)
         if (fabs(len - ranges.res.ranges[i]) > 2e-5 * ranges.res.ranges[i])
             fail_msg("ray %u: point at %.7f m, range %.7f m", i, len, (double)ranges.res.ranges[i]);
     }
-    set_noise(&f, 0.0f, 0.05f, 0.0f, 1.0f, 9);
-    run(&f, 1, &ids);
-    for (i = 0; i < f.n; ++i) assert_int_equal(ids.res.inst_ids[i], RC_INVALID_ID); /* a plain mesh: no instance */
+    /* an instance of the plane, every return dropped: inst_ids alone cannot
+     * tell returns apart and stay as traced (0); with hits they are lost */
+    {
+        rc_scene_desc wd = rc_scene_desc_default();
+        rc_instance_desc id = rc_instance_desc_default();
+        rc_scene *world = NULL;
+        rc_pose p = rct_pose(0.0f, 0.0f, 0.0f);
+        uint32_t inst = 9;
+        rct_buffers lost;
+        wd.max_geometries = 0;
+        wd.max_instances = 1;
+        RCT_OK(f.ctx, rc_scene_create(f.ctx, &wd, &world));
+        id.source = f.scene;
+        RCT_OK(f.ctx, rc_scene_add_instance(world, &id, &inst));
+        RCT_OK(f.ctx, rc_scene_commit(world));
+        rct_buffers_alloc(&lost, f.n, RC_ATTR_HITS | RC_ATTR_INST_IDS);
+        set_noise(&f, 0.0f, 0.05f, 0.0f, 1.0f, 9);
+        RCT_OK(f.ctx, rc_simulate(f.ctx, world, f.sensor, &p, 1, &ids.res));
+        RCT_OK(f.ctx, rc_simulate(f.ctx, world, f.sensor, &p, 1, &lost.res));
+        for (i = 0; i < f.n; ++i) {
+            assert_int_equal(ids.res.inst_ids[i], 0);
+            assert_int_equal(lost.res.hits[i], 0);
+            assert_int_equal(lost.res.inst_ids[i], RC_INVALID_ID);
+        }
+        rct_buffers_free(&lost);
+    }
     rct_buffers_free(&ranges);
     rct_buffers_free(&points);
     rct_buffers_free(&ids);
