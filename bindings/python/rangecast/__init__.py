@@ -10,7 +10,8 @@
         scan["ranges"].shape                               # (1, 16, 900), +inf = no return
 
 The binding is ctypes over librangecast.so (found through RANGECAST_LIBRARY,
-a source checkout's build/, or the system's library path) and numpy; it
+the library cmake --install put beside this package, a source checkout's
+build/, or the system's library path) and numpy; it
 compiles nothing. Failures raise rangecast.Error with the library's status and
 message. Conventions are the C header's (include/rangecast/rangecast.h):
 metres, radians, quaternions x y z w, base-to-map poses, REP 117 ranges.

@@ -239,8 +239,16 @@ def _candidates():
     if env:
         return [env]  # asked for this one: no silent fallback to another
     names = []
+    here = os.path.dirname(os.path.abspath(__file__))
+    # installed by cmake --install: _installed.py (generated) names the library
+    # installed with the package, relative to this folder
+    try:
+        from . import _installed
+        names.append(os.path.normpath(os.path.join(here, _installed.LIBRARY)))
+    except ImportError:
+        pass
     # a source checkout: bindings/python/rangecast -> <repo>/build/librangecast.so
-    repo = os.path.abspath(os.path.join(os.path.dirname(__file__), "..", "..", ".."))
+    repo = os.path.abspath(os.path.join(here, "..", "..", ".."))
     names.append(os.path.join(repo, "build", "librangecast.so"))
     found = ctypes.util.find_library("rangecast")
     if found:
