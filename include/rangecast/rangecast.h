@@ -415,6 +415,59 @@ RC_API rc_scene_info rc_scene_info_default(void);
 RC_API rc_status rc_scene_get_info(const rc_scene *scene, rc_scene_info *info);
 
 /* ------------------------------------------------------------------------ */
+/* Baked maps                                                                */
+/* ------------------------------------------------------------------------ */
+
+/* A baked map is a committed scene's meshes and built-in BVH in one
+ * relocatable, versioned, checksummed blob: bake it once (offline, with
+ * `rangecast bake`), then load it on the robot in place (from flash or an
+ * mmap'd file) with no parsing and no build. The layout is docs/baked-map.md:
+ * little-endian floats and uint32s only, the same blob on x86-64, aarch64 and
+ * armhf. Loading checks everything traversal relies on (the checksum, every
+ * offset, index and child link, and that every box holds what lies below it),
+ * so a corrupt or hostile blob is RC_ERR_CORRUPT_DATA, never a crash. */
+
+#define RC_BAKED_MAP_VERSION 1u  /* the blob format this library writes and reads */
+
+/* Writes the scene as a baked map. The scene must be committed, belong to a
+ * context on the built-in backend (RC_BACKEND_BVH: the blob holds its tree)
+ * and hold meshes only (RC_ERR_UNSUPPORTED for instances). blob NULL: *bytes
+ * gets the size and nothing is written. Otherwise capacity must be at least
+ * that size (RC_ERR_CAPACITY, nothing written) and *bytes gets the bytes
+ * written. The same scene gives the same bytes on every run and thread count.
+ * Allocates nothing. */
+RC_API rc_status rc_scene_bake(const rc_scene *scene, void *blob, size_t capacity, size_t *bytes);
+
+/* rc_scene_load_baked flags */
+#define RC_BAKED_SKIP_CHECKSUM 1u /* trust the bytes (checked once already); the structure is still checked */
+
+/* Exact arena bytes rc_scene_load_baked takes for this blob on the context's
+ * backend (the blob itself stays where it is and is not counted). Reads the
+ * header only. */
+RC_API rc_status rc_scene_baked_memory_requirements(const rc_context *ctx, const void *blob, size_t bytes,
+                                                    size_t *arena_bytes);
+
+/* Creates a committed, read-only scene from a baked map, referencing the blob
+ * in place: keep it alive and unchanged until the scene is destroyed. blob
+ * must be 16-byte aligned (malloc and mmap are). On the built-in backend the
+ * baked tree is used as it is, so ranges are bit-identical to those of the
+ * scene that was baked; Embree and Vulkan build their own structure from the
+ * blob's meshes. The scene's geometry ids are the baked scene's, its origin
+ * is the baked rc_scene_desc.origin, and it can be instanced like any scene
+ * of meshes. Adding to or updating it is RC_ERR_MISUSE. Errors: a blob that
+ * fails a check is RC_ERR_CORRUPT_DATA (the message names the check), a
+ * format version this library does not read is RC_ERR_UNSUPPORTED, no room
+ * in the arena is RC_ERR_OUT_OF_MEMORY; nothing is created then. */
+RC_API rc_status rc_scene_load_baked(rc_context *ctx, const void *blob, size_t bytes, uint32_t flags,
+                                     rc_scene **out);
+
+/* Geometry geom_id of a baked map as a mesh desc that references the blob
+ * (vertex_stride 16), e.g. to hand the map to code of your own. Checks the
+ * header and that geometry's offsets, not the checksum. */
+RC_API rc_status rc_baked_get_mesh(const void *blob, size_t bytes, uint32_t geom_id, rc_mesh_desc *mesh,
+                                   uint32_t *geometry_count);
+
+/* ------------------------------------------------------------------------ */
 /* Sensors                                                                   */
 /* ------------------------------------------------------------------------ */
 

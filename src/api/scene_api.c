@@ -80,41 +80,31 @@ rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_des
     return RC_OK;
 }
 
-rc_status rc_scene_create(rc_context *ctx, const rc_scene_desc *desc, rc_scene **out)
+rc_scene *rc__scene_new(rc_context *ctx, const rc_scene_desc *desc)
 {
-    void *block;
+    void *block = rc__arena_alloc(&ctx->arena, rc__scene_object_bytes(desc) - RC__ARENA_HEADER);
     rc_scene *s;
-    if (!rc__context_valid(ctx)) return RC_ERR_INVALID_HANDLE;
-    rc__clear_error(ctx);
-    RC_RETURN_IF(ctx, out == NULL, RC_ERR_INVALID_ARGUMENT, "out is NULL");
-    RC_TRY(check_scene_desc(ctx, desc));
-    block = rc__arena_alloc(&ctx->arena, rc__scene_object_bytes(desc) - RC__ARENA_HEADER);
-    RC_RETURN_IF(ctx, block == NULL, RC_ERR_OUT_OF_MEMORY,
+    if (block == NULL) {
+        rc__fail(ctx, RC_ERR_OUT_OF_MEMORY,
                  "arena has no room for the scene (%llu bytes; largest free block %llu; see "
                  "rc_scene_memory_requirements)",
                  (unsigned long long)rc__scene_object_bytes(desc),
                  (unsigned long long)rc__arena_largest_free(&ctx->arena));
+        return NULL;
+    }
     s = rc__scene_place(block, desc);
     s->ctx = ctx;
     s->magic = RC__MAGIC_SCENE;
     s->next = ctx->scenes;
     ctx->scenes = s;
-    *out = s;
-    return RC_OK;
+    return s;
 }
 
-rc_status rc_scene_destroy(rc_scene *scene)
+void rc__scene_free(rc_scene *scene)
 {
-    rc_context *ctx;
+    rc_context *ctx = scene->ctx;
     rc_scene **link;
     uint32_t i;
-    if (scene == NULL) return RC_OK;
-    if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
-    ctx = scene->ctx;
-    rc__clear_error(ctx);
-    RC_RETURN_IF(ctx, scene->instanced_by > 0, RC_ERR_MISUSE,
-                 "scene is the source of %u instance(s) in other scenes; destroy those scenes first",
-                 (unsigned)scene->instanced_by);
     if (ctx->backend->scene_release) ctx->backend->scene_release(scene);
     rc__scene_release_bvh(scene);
     for (i = 0; i < scene->inst_count; ++i) ((rc_scene *)scene->insts[i].source)->instanced_by--;
@@ -125,6 +115,32 @@ rc_status rc_scene_destroy(rc_scene *scene)
         }
     scene->magic = RC__MAGIC_DEAD;
     rc__arena_free(&ctx->arena, scene);
+}
+
+rc_status rc_scene_create(rc_context *ctx, const rc_scene_desc *desc, rc_scene **out)
+{
+    rc_scene *s;
+    if (!rc__context_valid(ctx)) return RC_ERR_INVALID_HANDLE;
+    rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, out == NULL, RC_ERR_INVALID_ARGUMENT, "out is NULL");
+    RC_TRY(check_scene_desc(ctx, desc));
+    s = rc__scene_new(ctx, desc);
+    if (s == NULL) return RC_ERR_OUT_OF_MEMORY;
+    *out = s;
+    return RC_OK;
+}
+
+rc_status rc_scene_destroy(rc_scene *scene)
+{
+    rc_context *ctx;
+    if (scene == NULL) return RC_OK;
+    if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
+    ctx = scene->ctx;
+    rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, scene->instanced_by > 0, RC_ERR_MISUSE,
+                 "scene is the source of %u instance(s) in other scenes; destroy those scenes first",
+                 (unsigned)scene->instanced_by);
+    rc__scene_free(scene);
     return RC_OK;
 }
 
@@ -172,6 +188,7 @@ rc_status rc_scene_add_mesh(rc_scene *scene, const rc_mesh_desc *desc, uint32_t 
     if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
     ctx = scene->ctx;
     rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, scene->baked, RC_ERR_MISUSE, "the scene was loaded from a baked map and is read-only");
     RC_RETURN_IF(ctx, geom_id == NULL, RC_ERR_INVALID_ARGUMENT, "geom_id is NULL");
     RC_TRY(check_mesh(ctx, desc));
     RC_RETURN_IF(ctx, scene->geom_count >= scene->desc.max_geometries, RC_ERR_CAPACITY,
@@ -229,6 +246,7 @@ rc_status rc_scene_update_mesh(rc_scene *scene, uint32_t geom_id)
     if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
     ctx = scene->ctx;
     rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, scene->baked, RC_ERR_MISUSE, "the scene was loaded from a baked map and is read-only");
     RC_RETURN_IF(ctx, geom_id >= scene->geom_count, RC_ERR_OUT_OF_RANGE, "geom_id %u: the scene has %u geometries",
                  (unsigned)geom_id, (unsigned)scene->geom_count);
     g = &scene->geoms[geom_id];
@@ -304,6 +322,7 @@ rc_status rc_scene_add_instance(rc_scene *scene, const rc_instance_desc *desc, u
     if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
     ctx = scene->ctx;
     rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, scene->baked, RC_ERR_MISUSE, "the scene was loaded from a baked map and is read-only");
     RC_RETURN_IF(ctx, inst_id == NULL, RC_ERR_INVALID_ARGUMENT, "inst_id is NULL");
     RC_TRY(rc__check_desc(ctx, desc, (uint32_t)sizeof *desc, (uint32_t)sizeof *desc, "desc"));
     RC_TRY(rc__check_reserved(ctx, desc->reserved, 8, "desc"));
@@ -338,6 +357,7 @@ rc_status rc_scene_set_instance_transform(rc_scene *scene, uint32_t inst_id, con
     if (!rc__scene_valid(scene)) return RC_ERR_INVALID_HANDLE;
     ctx = scene->ctx;
     rc__clear_error(ctx);
+    RC_RETURN_IF(ctx, scene->baked, RC_ERR_MISUSE, "the scene was loaded from a baked map and is read-only");
     RC_RETURN_IF(ctx, inst_id >= scene->inst_count, RC_ERR_OUT_OF_RANGE, "inst_id %u: the scene has %u instances",
                  (unsigned)inst_id, (unsigned)scene->inst_count);
     RC_RETURN_IF(ctx, transform == NULL, RC_ERR_INVALID_ARGUMENT, "transform is NULL");

@@ -12,6 +12,7 @@
 
 #include "bvh/intersect.h"
 #include "bvh/leaf4.h"
+#include "core/common.h"
 
 #include <float.h>
 #include <stddef.h>
@@ -25,6 +26,8 @@
 #endif
 
 #define LANES RC__PACKET_SIZE
+/* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
+#define PACKET_STACK (3u * RC__BVH_MAX_DEPTH + 4u)
 #define GROUPS (LANES / 4u)
 /* lanes_tmax's SIMD paths read exactly 16 lanes */
 typedef char rc__packet_lanes_check[LANES == 16u ? 1 : -1];
@@ -302,7 +305,7 @@ typedef struct packet_trav {
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
     /* up to three pushes per level */
-    packet_entry stack[3u * RC__BVH_MAX_DEPTH + 4u];
+    packet_entry stack[PACKET_STACK];
 } packet_trav;
 
 #if defined(RC__PACKET_SSE2)
@@ -454,7 +457,10 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             ++m;
         }
         if (m > 0) {
-            for (j = m; j-- > 1;) T->stack[T->sp++] = e[j]; /* depth is capped by the builder */
+            /* the builder caps depth so this always holds; a deeper tree (a
+             * hostile baked map) loses branches instead of the stack */
+            for (j = m; j-- > 1;)
+                if (RC__LIKELY(T->sp < PACKET_STACK)) T->stack[T->sp++] = e[j];
             T->child = e[0].child;
             T->count = e[0].count;
             T->mask = e[0].mask;

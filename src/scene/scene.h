@@ -13,6 +13,8 @@ typedef struct rc__geometry {
     void *bvh_block;          /* arena block holding mesh.bvh nodes and refs */
     uint32_t flags;           /* RC_MESH_* */
     uint32_t dirty;           /* 1: build, 2: refit at the next commit */
+    uint32_t baked;           /* 1: mesh.wide, bvh.refs and leaf_tris lie in a baked map (never rebuilt) */
+    uint32_t reserved0;
 } rc__geometry;
 
 typedef struct rc__instance {
@@ -43,6 +45,8 @@ struct rc_scene {
     uint64_t triangle_count;  /* over all own meshes */
     uint32_t instanced_by;    /* number of instances (in other scenes) that use this scene */
     uint32_t top_dirty;       /* top level needs rebuilding */
+    uint32_t baked;           /* 1: loaded from a baked map (read-only) */
+    uint32_t reserved1;
     uint64_t version;         /* bumped at every successful commit */
     uint64_t *source_versions;/* per instance: source->version seen at the last commit */
     rc__bvh top;              /* items: geometries 0..geom_count-1, then instances */
@@ -67,6 +71,27 @@ size_t rc__scene_bvh_commit_bytes(const rc_scene_desc *desc);
 rc_status rc__scene_build_wide(rc_scene *scene, rc_progress_fn progress, void *user);
 size_t rc__scene_wide_commit_bytes(const rc_scene_desc *desc);
 void rc__scene_release_bvh(rc_scene *scene);
+
+/* A scene object in the context's arena, linked into its list (scene_api.c);
+ * NULL with the message written when the arena has no room. */
+rc_scene *rc__scene_new(rc_context *ctx, const rc_scene_desc *desc);
+/* Releases a scene that no other scene instances: backend state, tree, object. */
+void rc__scene_free(rc_scene *scene);
+
+/* Baked maps (baked_write.c, baked_load.c). The bytes rc__scene_bake
+ * writes for a committed scene of meshes with wide trees, and the writer
+ * (blob holds exactly that many bytes). */
+uint64_t rc__scene_baked_bytes(const rc_scene *scene);
+void rc__scene_bake(const rc_scene *scene, unsigned char *blob);
+/* The scene desc a baked blob loads as on a backend (header checked;
+ * messages to ctx). */
+rc_status rc__baked_scene_desc(rc_context *ctx, const unsigned char *blob, size_t bytes, int prebuilt,
+                               rc_scene_desc *desc);
+/* Checks the whole blob (checksum unless skip_checksum) and creates the
+ * scene, ready for its backend's commit: prebuilt (the built-in backend)
+ * takes the baked trees in place, else the meshes are marked for a build. */
+rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_t bytes, int skip_checksum,
+                               int prebuilt, rc_scene **out);
 
 /* 1 when every instance's source is committed at the version seen at our commit. */
 int rc__scene_up_to_date(const rc_scene *scene);

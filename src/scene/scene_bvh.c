@@ -86,6 +86,7 @@ void rc__scene_release_bvh(rc_scene *scene)
     scene->accel_block_bytes = 0;
     memset(&scene->top, 0, sizeof scene->top);
     for (g = 0; g < scene->geom_count; ++g) {
+        if (scene->geoms[g].baked) continue; /* its tree lives in the blob */
         memset(&scene->geoms[g].mesh.bvh, 0, sizeof scene->geoms[g].mesh.bvh);
         scene->geoms[g].mesh.leaf_tris = NULL;
         scene->geoms[g].mesh.wide = NULL;
@@ -210,6 +211,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
         rc__geometry *geo = &scene->geoms[g];
         rc__mesh *mesh = &geo->mesh;
         uint32_t n = rc__bvh_node_count(mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE);
+        if (geo->baked) continue; /* a baked map's tree, in place; the block reserved nothing for it */
         if (geo->dirty == 1) {
             mesh->bvh.nodes = wide ? scratch_nodes : nodes + node_off;
             mesh->bvh.refs = refs + ref_off;
