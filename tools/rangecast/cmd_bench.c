@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "baked_file.h"
 #include "mesh_load.h"
 #include "poses.h"
 #include "reference.h"
@@ -41,7 +42,7 @@ static void usage(FILE *f)
         "origin, or the centre of --map's bounds) with uniformly random orientations.\n"
         "\n"
         "Options:\n"
-        "  --map FILE         mesh map (.ply, or any Assimp format)\n"
+        "  --map FILE         mesh map (.ply, a baked .rcmap, or any Assimp format)\n"
         "  --poses FILE       raw poses: float32 LE x y z qx qy qz qw per pose\n"
         "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40;\n"
         "                     random-ondn: 14,400 incoherent OnDn rays (origins in a 5 m ball,\n"
@@ -62,9 +63,12 @@ static void usage(FILE *f)
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
         "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
-        "build_quality.\n"
+        "build_quality baked_map_bytes.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
+        "A baked map (.rcmap, rangecast bake) is loaded in place: build_s is then the load\n"
+        "(rc_scene_load_baked), and the mesh and tree it holds are baked_map_bytes (null\n"
+        "for other maps), outside the arena.\n"
         "Timing: all poses, up to 1000 a call, ranges only, after a warm-up of 8 scans.\n"
         "Accuracy (untimed): each hit's range against the float64 distance from the\n"
         "pose's sensor origin along the float64 ray to the hit triangle's plane.\n"
@@ -651,9 +655,11 @@ int rcp_cmd_bench(int argc, char **argv)
         printf(",\"hit_mismatch\":");
         if (is_sphere) printf("%llu", (unsigned long long)acc.mismatch);
         else printf("null");
-        printf(",\"ranges_consistent\":%s,\"build_quality\":\"%s\"}\n",
+        printf(",\"ranges_consistent\":%s,\"build_quality\":\"%s\",\"baked_map_bytes\":",
                acc.differing == 0 && acc.inconsistent == 0 && acc.bad_prims == 0 ? "true" : "false",
                rcp_build_quality_name(rcp_build_quality));
+        if (rcp_baked_of(&mesh)) printf("%llu}\n", (unsigned long long)rcp_baked_of(&mesh)->bytes);
+        else printf("null}\n");
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;

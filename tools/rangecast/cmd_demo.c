@@ -120,10 +120,8 @@ int rcp_cmd_demo(int argc, char **argv)
             dir = v;
         } else if ((r = rcp_opt(argc, argv, &i, "--backend", &v)) != 0) {
             if (r < 0 || rcp_parse_backend(cmd, v, &backend) != 0) return RCP_EXIT_USAGE;
-        } else if ((r = rcp_opt(argc, argv, &i, "--threads", &v)) != 0) {
+        } else if ((r = rcp_opt_threads(cmd, argc, argv, &i, &threads)) != 0) {
             if (r < 0) return RCP_EXIT_USAGE;
-            if (rcp_parse_u32(v, &threads) != 0 || threads > RC_MAX_THREADS)
-                return rcp_usage_error(cmd, "--threads: expected 0..%u, got '%s'", RC_MAX_THREADS, v);
         } else {
             return rcp_usage_error(cmd, "unknown argument '%s'", argv[i]);
         }

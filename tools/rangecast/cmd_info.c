@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "baked_file.h"
 #include "mesh_load.h"
 #include "tool.h"
 #include "util.h"
@@ -45,10 +46,8 @@ int rcp_cmd_info(int argc, char **argv)
         } else if ((r = rcp_opt(argc, argv, &i, "--backend", &v)) != 0) {
             if (r < 0 || rcp_parse_backend(cmd, v, &backend) != 0) return RCP_EXIT_USAGE;
             only_one = 1;
-        } else if ((r = rcp_opt(argc, argv, &i, "--threads", &v)) != 0) {
+        } else if ((r = rcp_opt_threads(cmd, argc, argv, &i, &threads)) != 0) {
             if (r < 0) return RCP_EXIT_USAGE;
-            if (rcp_parse_u32(v, &threads) != 0 || threads > RC_MAX_THREADS)
-                return rcp_usage_error(cmd, "--threads: expected 0..%u, got '%s'", RC_MAX_THREADS, v);
         } else {
             return rcp_usage_error(cmd, "unknown argument '%s'", argv[i]);
         }
@@ -107,6 +106,10 @@ int rcp_cmd_info(int argc, char **argv)
                w.build_s);
         rcp_world_destroy(&w);
     }
+    if (rcp_baked_of(&mesh))
+        printf("\n(a baked map of %s: the tree comes with it, so build s is rc_scene_load_baked, checks\n"
+               "included, and the scene's bytes count the arena only; the map stays in its file.)\n",
+               rcp_bytes(rcp_baked_of(&mesh)->bytes, n1, sizeof n1));
     printf("\narena bytes: rc_context_memory_requirements + rc_scene_memory_requirements (the peak,\n"
            "build scratch included); scene bytes: what the committed scene keeps in the arena\n"
            "(rc_scene_get_info); outside arena: what Embree/Vulkan hold themselves; bytes/tri:\n"

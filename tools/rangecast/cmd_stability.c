@@ -54,10 +54,8 @@ int rcp_cmd_stability(int argc, char **argv)
                 if (rcp_parse_backend(cmd, tok, &backends[nb]) != 0) return RCP_EXIT_USAGE;
                 nb++;
             }
-        } else if ((r = rcp_opt(argc, argv, &i, "--threads", &v)) != 0) {
+        } else if ((r = rcp_opt_threads(cmd, argc, argv, &i, &threads)) != 0) {
             if (r < 0) return RCP_EXIT_USAGE;
-            if (rcp_parse_u32(v, &threads) != 0 || threads > RC_MAX_THREADS)
-                return rcp_usage_error(cmd, "--threads: expected 0..%u, got '%s'", RC_MAX_THREADS, v);
         } else if (strcmp(argv[i], "--markdown") == 0) {
             markdown = 1;
         } else if (strcmp(argv[i], "--quick") == 0) {

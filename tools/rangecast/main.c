@@ -20,6 +20,7 @@ static void usage(FILE *f)
         "  demo       build a demo warehouse, simulate a VLP-16 and a D435 in it, write clouds and images\n"
         "  simulate   simulate a sensor at poses in a mesh map; write a point cloud (and a range image)\n"
         "  bench      scans per second and range accuracy on a map; prints one JSON line\n"
+        "  bake       build a map's BVH once and write it as a baked map (.rcmap) that loads in place\n"
         "  info       a map's size and bounds, and per backend its arena bytes and build time\n"
         "  accuracy   every ray against the float64 reference tracer: disagreements, range errors by incidence\n"
         "  stability  the stability cases (grazing, degenerate, far origin ...) per backend against the reference\n"
@@ -45,6 +46,7 @@ int main(int argc, char **argv)
                     {"bench", rcp_cmd_bench},
                     {"demo", rcp_cmd_demo},
                     {"info", rcp_cmd_info},
+                    {"bake", rcp_cmd_bake},
                     {"gen", rcp_cmd_gen},
                     {"accuracy", rcp_cmd_accuracy},
                     {"stability", rcp_cmd_stability},

@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "baked_file.h"
 #include "ply.h"
 #include "util.h"
 
@@ -119,9 +120,9 @@ fail:
 const char *rcp_mesh_formats(void)
 {
 #if defined(RANGECAST_WITH_ASSIMP)
-    return "ply (built-in reader); obj, stl, off, dae, gltf, glb, fbx, 3ds and the rest through Assimp";
+    return "ply (built-in reader), rcmap (baked maps); obj, stl, off, dae, gltf, glb, fbx, 3ds and the rest through Assimp";
 #else
-    return "ply only (this program was built without Assimp)";
+    return "ply and rcmap (baked maps) only (this program was built without Assimp)";
 #endif
 }
 
@@ -131,10 +132,11 @@ int rcp_mesh_load(const char *path, rcu_mesh *out)
     rcu_path_extension(path, ext, sizeof ext);
     memset(out, 0, sizeof *out);
     if (strcmp(ext, "ply") == 0) return rcu_mesh_read_ply(path, out);
+    if (strcmp(ext, "rcmap") == 0) return rcp_baked_load_mesh(path, out);
 #if defined(RANGECAST_WITH_ASSIMP)
     return load_assimp(path, ext, out);
 #else
     return rcu_fail("%s: cannot read '.%s' files: this rangecast was built without Assimp, so maps "
-                    "must be .ply", path, ext);
+                    "must be .ply or .rcmap", path, ext);
 #endif
 }

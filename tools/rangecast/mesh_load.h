@@ -1,4 +1,6 @@
-/* Loading maps: .ply with rcutil's own reader (fast, exact), every other
+/* Loading maps: .ply with rcutil's own reader (fast, exact), .rcmap baked
+ * maps (baked_file.h: mapped, and copied for the commands that read the
+ * triangles), every other
  * format (.obj .stl .dae .gltf .glb .fbx .3ds .off ...) through Assimp's C API
  * when the program was built with it. */
 #ifndef RCP_MESH_LOAD_H

@@ -8,6 +8,7 @@
 #include <string.h>
 #include <unistd.h>
 
+#include "baked_file.h"
 #include "util.h"
 
 static void vmessage(const char *cmd, const char *fmt, va_list ap)
@@ -67,6 +68,18 @@ static int create_context(const char *cmd, rc_context_desc *desc, rc_context **o
     why[0] = '\0';
     if ((st = rc_context_create(desc, out)) == RC_OK) return RCP_EXIT_OK;
     return rcp_fail(cmd, "rc_context_create failed: %s%s%s", rc_status_string(st), why[0] ? ": " : "", why);
+}
+
+int rcp_opt_threads(const char *cmd, int argc, char **argv, int *i, uint32_t *threads)
+{
+    const char *v = NULL;
+    const int r = rcp_opt(argc, argv, i, "--threads", &v);
+    if (r <= 0) return r;
+    if (rcp_parse_u32(v, threads) != 0 || *threads > RC_MAX_THREADS) {
+        rcp_usage_error(cmd, "--threads: expected 0..%u, got '%s'", RC_MAX_THREADS, v);
+        return -1;
+    }
+    return 1;
 }
 
 int rcp_is_help(const char *arg)
@@ -262,10 +275,13 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
         if ((st = rc_context_memory_requirements(&pd, &probe_bytes)) != RC_OK)
             return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
         pd.memory_size = probe_bytes;
+        const rcp_baked *baked = rcp_baked_of(mesh);
         if (create_context(cmd, &pd, &probe) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
-        st = rc_scene_memory_requirements(probe, &sd, &sb);
+        st = baked ? rc_scene_baked_memory_requirements(probe, baked->blob, baked->bytes, &sb)
+                   : rc_scene_memory_requirements(probe, &sd, &sb);
         if (st != RC_OK) {
-            rcp_lib_error(cmd, probe, "rc_scene_memory_requirements", st);
+            rcp_lib_error(cmd, probe, baked ? "rc_scene_baked_memory_requirements" : "rc_scene_memory_requirements",
+                          st);
             rc_context_destroy(probe);
             return RCP_EXIT_FAIL;
         }
@@ -380,7 +396,14 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     if (create_context(cmd, &cd, &w->ctx) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
     rc_context_get_backend(w->ctx, &w->backend);
     rc_context_get_thread_count(w->ctx, &w->threads);
-    if (mesh) {
+    if (mesh && rcp_baked_of(mesh)) {
+        /* a baked map: loaded in place, checked, no build */
+        const rcp_baked *baked = rcp_baked_of(mesh);
+        const double t0 = rcu_now();
+        call = "rc_scene_load_baked";
+        if ((st = rc_scene_load_baked(w->ctx, baked->blob, baked->bytes, 0, &w->scene)) != RC_OK) goto fail;
+        w->build_s = rcu_now() - t0;
+    } else if (mesh) {
         rc_scene_desc sd = scene_desc_for(mesh);
         rc_mesh_desc md = rc_mesh_desc_default();
         uint32_t geom = 0;

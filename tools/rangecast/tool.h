@@ -24,6 +24,7 @@ int rcp_cmd_simulate(int argc, char **argv);
 int rcp_cmd_bench(int argc, char **argv);
 int rcp_cmd_demo(int argc, char **argv);
 int rcp_cmd_info(int argc, char **argv);
+int rcp_cmd_bake(int argc, char **argv);
 int rcp_cmd_gen(int argc, char **argv);
 
 /* "rangecast CMD: message" + a pointer to --help on stderr; returns RCP_EXIT_USAGE. */
@@ -39,6 +40,9 @@ int rcp_lib_error(const char *cmd, const rc_context *ctx, const char *call, rc_s
  * another argument, -1 when the value is missing (message printed). */
 int rcp_opt(int argc, char **argv, int *i, const char *name, const char **value);
 int rcp_is_help(const char *arg);
+/* --threads N (0..RC_MAX_THREADS): as rcp_opt, and -1 (message printed) for a
+ * bad number too. */
+int rcp_opt_threads(const char *cmd, int argc, char **argv, int *i, uint32_t *threads);
 /* Numbers; 0 on success, -1 on a malformed or out-of-range value (no message). */
 int rcp_parse_u32(const char *s, uint32_t *out);
 /* A count with an optional suffix: 1k = 1000, 1M = 10^6, 1G = 10^9. */
@@ -70,7 +74,7 @@ typedef struct rcp_world {
     uint32_t threads;                    /* threads simulate uses */
     size_t arena_bytes;                  /* desc.memory_size we asked for */
     size_t scene_bytes;                  /* rc_scene_memory_requirements */
-    double build_s;                      /* wall time of rc_scene_commit */
+    double build_s;                      /* wall time of rc_scene_commit (rc_scene_load_baked for a .rcmap) */
 } rcp_world;
 
 /* Creates the world; on failure prints the error (as cmd) and returns

@@ -1,0 +1,65 @@
+#!/bin/sh
+# `rangecast bake` and baked maps (.rcmap) in the other commands, as a user
+# runs them: the baked map gives the PLY map's ranges bit for bit (bench
+# --ranges-out), bench reports its size, simulate and info read it, and a
+# corrupt, truncated or misnamed map gets its exit status and message with no
+# output file left behind.
+#   check_bake.sh RANGECAST WORKDIR [--backend B]
+set -eu
+RC=$1
+WORK=$2
+shift 2
+BACKEND=${*:-}
+. "$(dirname "$0")/common.sh"
+
+run 0 "" "$RC" gen --sphere 10k --radius 20 -o sphere.ply
+run 0 "" "$RC" gen --poses 20 --radius 10 --seed 5 -o poses.bin
+run 0 "" "$RC" bake --map sphere.ply --out sphere.rcmap --threads 2
+grep -q "sphere.rcmap: 9,996 triangles" out.txt || { cat out.txt; fail "bake summary"; }
+grep -q "loads in" out.txt || fail "bake reports the load time"
+size=$(wc -c <sphere.rcmap)
+[ $((size % 64)) -eq 0 ] || fail "a baked map is a multiple of 64 bytes, not $size"
+[ "$(head -c 6 sphere.rcmap | tail -c 5)" = "RCMAP" ] || fail "magic"
+ls ./*.part* 2>/dev/null && fail "bake left a temporary file"
+
+# the same ranges from the PLY map and from the baked one, and the same again
+# on a second bake (the bytes are deterministic)
+run 0 "" "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 --ranges-out ply.f32 $BACKEND
+grep -q '"baked_map_bytes":null}' out.txt || fail "bench on a PLY map: baked_map_bytes is null"
+run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2 --ranges-out baked.f32 $BACKEND
+grep -q "\"baked_map_bytes\":$size}" out.txt || { cat out.txt; fail "bench reports the baked map's bytes"; }
+grep -q '"hit_mismatch":null' out.txt || true
+cmp ply.f32 baked.f32 || fail "a baked map changed the ranges"
+run 0 "" "$RC" bake --map sphere.ply --out again.rcmap --threads 1
+cmp sphere.rcmap again.rcmap || fail "two bakes of one map differ"
+# bench --help lists every key the JSON line has
+run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 1 $BACKEND
+keys=$(tr ',{' '\n\n' <out.txt | sed -n 's/^"\([a-z_0-9]*\)":.*/\1/p')
+"$RC" bench --help >help.txt
+for k in $keys; do
+    case $k in tool | version) continue ;; esac
+    grep -qw "$k" help.txt || fail "bench --help does not list the JSON key $k"
+done
+
+# simulate and info read it
+run 0 "" "$RC" simulate --map sphere.rcmap --pose 0,0,0 -o centre.pcd --ascii --fields range $BACKEND
+grep -qx "POINTS 14400" centre.pcd || fail "simulate on a baked map: point count"
+run 0 "" "$RC" info --map sphere.rcmap --backend bvh
+grep -q "a baked map of" out.txt || fail "info says the map is baked"
+
+# bad maps: each refused with its reason, nothing written
+cp sphere.rcmap flipped.rcmap
+printf '\377' | dd of=flipped.rcmap bs=1 seek=$((size / 2)) conv=notrunc 2>/dev/null
+run 1 "checksum" "$RC" bench --map flipped.rcmap --poses poses.bin --repeat 1 --ranges-out bad.f32 $BACKEND
+[ ! -e bad.f32 ] || fail "bench on a corrupt map wrote ranges"
+head -c $((size - 64)) sphere.rcmap >short.rcmap
+run 1 "truncated" "$RC" simulate --map short.rcmap --pose 0,0,0 -o bad.pcd $BACKEND
+[ ! -e bad.pcd ] || fail "simulate on a truncated map wrote a cloud"
+cp sphere.ply notbaked.rcmap
+run 1 "not a baked map" "$RC" info --map notbaked.rcmap
+run 2 ".rcmap" "$RC" bake --map sphere.ply --out sphere.bin
+run 1 "No such file" "$RC" bake --map sphere.ply --out no/such/dir/x.rcmap
+[ ! -e no ] || fail "bake made a folder"
+run 1 "" "$RC" bake --map missing.ply --out x.rcmap
+[ ! -e x.rcmap ] || fail "bake of a missing map wrote a file"
+echo "check_bake: ok"
