@@ -1,6 +1,7 @@
 /* The core path makes no allocation after rc_context_create: malloc, calloc
  * and realloc are wrapped (-Wl,--wrap) and counted while a scene is built,
- * committed, a sensor made and a batch simulated on two threads. */
+ * committed, a sensor made and a batch simulated on two threads, and while
+ * the scene is baked into a block the caller made and loaded from it. */
 #include <stdlib.h>
 
 #include "rc_test.h"
@@ -35,7 +36,9 @@ static void test_no_allocation_after_create(void **state)
 {
     rcu_mesh m;
     rc_context *ctx;
-    rc_scene *scene, *top;
+    rc_scene *scene, *top, *baked = NULL;
+    void *blob;
+    size_t blob_bytes = 0;
     rc_scene_desc sd = rc_scene_desc_default();
     rc_mesh_desc md = rc_mesh_desc_default();
     rc_instance_desc id = rc_instance_desc_default();
@@ -71,12 +74,22 @@ static void test_no_allocation_after_create(void **state)
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, 4, &buf.res));
     RCT_OK(ctx, rc_simulate(ctx, top, sensor, poses, 4, &buf.res));
     RCT_OK(ctx, rc_scene_destroy(top));
+    /* a baked map: bake into the caller's block, load it in place, trace it */
+    RCT_OK(ctx, rc_scene_bake(scene, NULL, 0, &blob_bytes));
+    counting = 0;
+    blob = rct_alloc16(blob_bytes);
+    counting = 1;
+    RCT_OK(ctx, rc_scene_bake(scene, blob, blob_bytes, &blob_bytes));
+    RCT_OK(ctx, rc_scene_load_baked(ctx, blob, blob_bytes, 0, &baked));
+    RCT_OK(ctx, rc_simulate(ctx, baked, sensor, poses, 4, &buf.res));
+    RCT_OK(ctx, rc_scene_destroy(baked));
     RCT_OK(ctx, rc_sensor_destroy(sensor));
     counting = 0;
 
     assert_int_equal(calls, 0);
     assert_int_equal(buf.res.hits[0], 1);
     rc_context_destroy(ctx);
+    free(blob);
     rct_buffers_free(&buf);
     rcu_mesh_free(&m);
 }
