@@ -582,7 +582,9 @@ static void test_random_flips_never_crash(void **state)
     unsigned char *b;
     uint64_t x = 0x9E3779B97F4A7C15ull;
     uint32_t round, rounds = rct_quick() ? 200u : 3000u, loaded = 0;
+    const char *env = getenv("RC_FUZZ_ROUNDS"); /* explores further, as in test_fuzz_api */
     (void)state;
+    if (env && atoi(env) > 0) rounds = (uint32_t)atoi(env);
     ctx = baked_fixture(&m, 1, &scene);
     RCT_OK(ctx, rc_scene_destroy(scene));
     RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &s));

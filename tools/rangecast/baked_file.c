@@ -67,43 +67,38 @@ static const char *header_problem(const rcp_baked *b, rc_status st)
 int rcp_baked_load_mesh(const char *path, rcu_mesh *out)
 {
     rcp_baked b;
-    uint32_t geoms = 0, g;
-    uint64_t nv = 0, nt = 0;
+    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t geoms = 0;
+    uint64_t i;
     rc_status st;
     memset(out, 0, sizeof *out);
     if (map_count == MAX_MAPS) return rcu_fail("%s: more than %d baked maps open", path, MAX_MAPS);
     if (map_file(path, &b) != 0) return -1;
-    st = rc_baked_get_mesh(b.blob, b.bytes, 0, NULL, &geoms);
-    for (g = 0; st == RC_OK && g < geoms; ++g) {
-        rc_mesh_desc md = rc_mesh_desc_default();
-        st = rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL);
-        nv += md.vertex_count;
-        nt += md.triangle_count;
+    st = rc_baked_get_mesh(b.blob, b.bytes, 0, &md, &geoms);
+    if (st == RC_OK && geoms != 1) {
+        /* the commands read a map as one mesh: their float64 reference finds
+         * a hit's triangle by its prim id alone */
+        rcu_fail("%s holds %u geometries; this program reads baked maps of one mesh, as 'rangecast bake' "
+                 "writes them (load others with rc_scene_load_baked)",
+                 path, (unsigned)geoms);
+    } else if (st != RC_OK) {
+        rcu_fail("%s: %s; bake it again with 'rangecast bake'", path, header_problem(&b, st));
+    } else if (rcu_mesh_reserve(out, md.vertex_count, md.triangle_count) != 0) {
+        rcu_fail("%s: out of memory copying its triangles", path);
+    } else {
+        for (i = 0; i < md.vertex_count; ++i) /* 16-byte vertices to packed xyz */
+            memcpy(out->vertices + 3u * (size_t)i, md.vertices + 4u * (size_t)i, 3 * sizeof(float));
+        memcpy(out->indices, md.indices, (size_t)md.triangle_count * 3u * sizeof(uint32_t));
+        out->vertex_count = (uint32_t)md.vertex_count;
+        out->triangle_count = (uint32_t)md.triangle_count;
+        maps[map_count].vertices = out->vertices;
+        maps[map_count].baked = b;
+        map_count++;
+        return 0;
     }
-    if (st == RC_OK && (nv > 0xFFFFFFF0u || nt > 0xFFFFFFF0u)) st = RC_ERR_CORRUPT_DATA;
-    if (st == RC_OK && rcu_mesh_reserve(out, nv, nt) != 0) st = RC_ERR_OUT_OF_MEMORY;
-    for (g = 0; st == RC_OK && g < geoms; ++g) {
-        rc_mesh_desc md = rc_mesh_desc_default();
-        uint64_t i;
-        const uint32_t base = out->vertex_count;
-        rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL);
-        for (i = 0; i < md.vertex_count; ++i)
-            memcpy(out->vertices + 3u * (size_t)(base + i), md.vertices + 4u * (size_t)i, 3 * sizeof(float));
-        for (i = 0; i < 3u * md.triangle_count; ++i) out->indices[3u * (size_t)out->triangle_count + i] = base + md.indices[i];
-        out->vertex_count += (uint32_t)md.vertex_count;
-        out->triangle_count += (uint32_t)md.triangle_count;
-    }
-    if (st != RC_OK) {
-        if (st == RC_ERR_OUT_OF_MEMORY) rcu_fail("%s: out of memory copying its triangles", path);
-        else rcu_fail("%s: %s; bake it again with 'rangecast bake'", path, header_problem(&b, st));
-        rcu_mesh_free(out);
-        munmap((void *)(uintptr_t)b.blob, b.bytes);
-        return -1;
-    }
-    maps[map_count].vertices = out->vertices;
-    maps[map_count].baked = b;
-    map_count++;
-    return 0;
+    rcu_mesh_free(out);
+    munmap((void *)(uintptr_t)b.blob, b.bytes);
+    return -1;
 }
 
 const rcp_baked *rcp_baked_of(const rcu_mesh *mesh)

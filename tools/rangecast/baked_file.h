@@ -14,8 +14,9 @@ typedef struct rcp_baked {
     size_t bytes;
 } rcp_baked;
 
-/* Maps path and copies every geometry's triangles into out (one mesh, the
- * geometries' vertices and indices one after another). Remembers the mapping
+/* Maps path and copies its mesh's triangles into out; a map of several
+ * geometries (made with the C API) is refused, since the commands' float64
+ * reference finds a hit's triangle by prim id alone. Remembers the mapping
  * for rcp_baked_of(out). 0 on success; -1 with rcu_last_error(). */
 int rcp_baked_load_mesh(const char *path, rcu_mesh *out);
 
