@@ -8,6 +8,7 @@
         lidar = ctx.preset_sensor("vlp16")
         scan = ctx.simulate(scene, lidar, [0, 0, 1, 0, 0, 0, 1], ("ranges", "points"))
         scan["ranges"].shape                               # (1, 16, 900), +inf = no return
+        scene.bake("map.rcmap")                            # later: ctx.load_baked("map.rcmap")
 
 The binding is ctypes over librangecast.so (found through RANGECAST_LIBRARY,
 the library cmake --install put beside this package, a source checkout's

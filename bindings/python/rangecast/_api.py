@@ -8,10 +8,17 @@ as rc_context_destroy does, and later use raises Error(ERR_INVALID_HANDLE).
 The C rule "a context is used by one thread at a time" is kept by a lock per
 context: ctypes lets other Python threads run during a call, so without it two
 threads could enter one context at once. Different contexts run in parallel.
+
+Memory a scene reads in place (referenced meshes' arrays, a loaded baked map)
+is held by its Scene until the C scene is destroyed: by close(), by the
+context's close(), or after the garbage collector drops the Scene, at the end
+of the call that was running then.
 """
 
 import ctypes
 import math
+import mmap
+import os
 import threading
 
 import numpy as np
@@ -183,10 +190,13 @@ class Context(object):
         self._owner = threading.get_ident()
 
     def _leave(self):
-        # destroys the garbage collector asked for while a call ran
+        # destroys the garbage collector asked for while a call ran; what the
+        # object referenced lives until its destroy has run (dropping it may
+        # queue a source scene, which this loop then destroys)
         while self._pending and self._h is not None:
-            fn, handle = self._pending.pop()
+            fn, handle, keep = self._pending.pop()
             fn(handle)
+            del keep
         self._owner = None
         self._lock.release()
 
@@ -203,18 +213,19 @@ class Context(object):
         if status != F.OK:
             raise Error(status, message or what)
 
-    def _release(self, fn, handle):
+    def _release(self, fn, handle, keep=None):
         """Destroys a scene or sensor the garbage collector dropped: now when
         the context is free, else at the end of the call that holds it
-        (never inside it: a callback may be what dropped the object)."""
+        (never inside it: a callback may be what dropped the object). keep:
+        the memory the C object reads, held until the destroy has run."""
         if self._h is None:
             return  # freed with the context
         if self._owner is None and self._lock.acquire(False):
             self._owner = threading.get_ident()
-            self._pending.append((fn, handle))
+            self._pending.append((fn, handle, keep))
             self._leave()
         else:
-            self._pending.append((fn, handle))
+            self._pending.append((fn, handle, keep))
 
     # -- queries ----------------------------------------------------------
     @property
@@ -258,6 +269,35 @@ class Context(object):
         scene.add_mesh(v, t, copy=copy)
         scene.commit(progress)
         return scene
+
+    def load_baked(self, source, skip_checksum=False):
+        """A committed, read-only scene from a baked map (Scene.bake, or the
+        .rcmap files of `rangecast bake`), used in place: no build, and on
+        the "bvh" backend ranges bit-identical to the baked scene's; Embree
+        and Vulkan build their own structure from its meshes.
+
+        source: a path (str or os.PathLike), mapped read-only (replace the
+        file by renaming, as bake(path) does, never by rewriting it while a
+        scene maps it); bytes or a read-only mmap, used in place; any other
+        bytes-like object (bytearray, memoryview, numpy array), copied once,
+        so that later changes to it do not reach the scene. The scene holds
+        the mapping or bytes until it is closed. skip_checksum=True skips the
+        CRC-32C of the whole blob (RC_BAKED_SKIP_CHECKSUM) for a map checked
+        once already; the structure is still checked. A blob that fails a
+        check raises Error(ERR_CORRUPT_DATA) naming the check; a file that
+        cannot be read, Error(ERR_IO). Adding to or updating the scene raises
+        Error(ERR_MISUSE)."""
+        self._handle()
+        blob = _baked_blob(source)
+        handle = ctypes.c_void_p()
+        flags = F.BAKED_SKIP_CHECKSUM if skip_checksum else 0
+        try:
+            self._call("rc_scene_load_baked", F.lib.rc_scene_load_baked, self._handle(), blob.array.ctypes.data,
+                       blob.array.size, flags, ctypes.byref(handle))
+        except BaseException:
+            blob.close()
+            raise
+        return Scene._loaded(self, handle, blob)
 
     # -- sensors ----------------------------------------------------------
     def preset_sensor(self, name):
@@ -395,6 +435,83 @@ def _out_buffer(out, name, shape, dtype):
     return buf
 
 
+def _aligned_empty(size, align=64):
+    """size uint8s from an align-byte boundary (numpy promises only the
+    item's alignment; baked-map sections are 64-byte aligned)."""
+    block = np.empty(size + align, dtype=np.uint8)
+    skip = -block.ctypes.data % align
+    return block[skip:skip + size]
+
+
+class _Blob(object):
+    """The baked map a loaded scene reads in place: a uint8 array over the
+    caller's bytes, an aligned copy or a file's read-only mapping (then
+    closed with the scene, not left to the garbage collector)."""
+
+    def __init__(self, array, mapping=None):
+        self.array = array
+        self.mapping = mapping
+
+    def close(self):
+        self.array = None  # the mapping's only export: it can close now
+        if self.mapping is not None:
+            self.mapping.close()
+            self.mapping = None
+
+
+def _baked_blob(source):
+    if isinstance(source, (str, os.PathLike)):
+        return _map_file(os.fspath(source))
+    try:
+        raw = np.frombuffer(source, dtype=np.uint8)
+    except (TypeError, ValueError, BufferError) as exc:
+        raise Error(F.ERR_INVALID_ARGUMENT, "source must be a path (str or os.PathLike) or a contiguous "
+                    "bytes-like object, got %s (%s)" % (type(source).__name__, exc))
+    # bytes cannot change, and a read-only mmap is the caller's own mapping:
+    # both are used in place where aligned; anything else could change
+    # under the scene, so it is copied
+    in_place = type(source) is bytes or (isinstance(source, mmap.mmap) and not raw.flags.writeable)
+    if in_place and raw.ctypes.data % F.BAKED_ALIGN == 0:
+        return _Blob(raw)
+    copy = _aligned_empty(raw.size)
+    copy[:] = raw
+    return _Blob(copy)
+
+
+def _map_file(path):
+    try:
+        with open(path, "rb") as f:
+            if os.fstat(f.fileno()).st_size == 0:
+                raise Error(F.ERR_CORRUPT_DATA, "%s is empty, not a baked map" % path)
+            mapping = mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ)  # holds its own descriptor
+    except OSError as exc:
+        raise Error(F.ERR_IO, "cannot read the baked map %s: %s" % (path, exc)) from exc
+    return _Blob(np.frombuffer(mapping, dtype=np.uint8), mapping)
+
+
+def _write_replacing(path, data):
+    """Writes data to path through a temporary file beside it, renamed into
+    place (as `rangecast bake` does): a reader sees the old file or the whole
+    new one, and a scene mapping the old file keeps it."""
+    tmp = "%s.part%d-%s" % (path, os.getpid(), os.urandom(4).hex())
+    try:
+        f = open(tmp, "xb")  # 0666 less the umask, like any new file
+        try:
+            with f:
+                f.write(data)
+                f.flush()
+                os.fsync(f.fileno())  # the bytes reach the disk before the name does
+            os.replace(tmp, path)
+        except BaseException:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
+            raise
+    except OSError as exc:
+        raise Error(F.ERR_IO, "cannot write the baked map %s: %s" % (path, exc)) from exc
+
+
 def _common(common, range_min, range_max, mounting):
     common.range_min = float(range_min)
     common.range_max = float(range_max)
@@ -435,6 +552,11 @@ class _Child(object):
             raise Error(F.ERR_INVALID_HANDLE, "%s is closed (or its context is)" % type(self).__name__)
         return self._h
 
+    def _keepalive(self):
+        """What the C object reads in place (a sensor: nothing, the library
+        copies its rays)."""
+        return None
+
     def __enter__(self):
         return self
 
@@ -447,16 +569,18 @@ class _Child(object):
         # a scene another scene still instances cannot go (the destroy says
         # RC_ERR_MISUSE, ignored): it is freed with the context
         try:
-            self._ctx._release(self._destroy_fn, self._h)
+            self._ctx._release(self._destroy_fn, self._h, self._keepalive())
         except Exception:  # interpreter shutdown: the process frees the arena
             pass
         self._h = None
 
 
 class Scene(_Child):
-    """A scene of meshes and instances; commit() before simulating."""
+    """A scene of meshes and instances; commit() before simulating. A scene
+    from Context.load_baked is committed and read-only."""
 
     _destroy_fn = staticmethod(lambda h: F.lib.rc_scene_destroy(h))
+    _blob = None
 
     def __init__(self, ctx, max_triangles, max_geometries, max_instances, max_vertices, max_copied_triangles,
                  origin, build_quality):
@@ -471,17 +595,53 @@ class Scene(_Child):
         d.build_quality = _lookup(_QUALITIES, build_quality, "build_quality")
         handle = ctypes.c_void_p()
         ctx._call("rc_scene_create", F.lib.rc_scene_create, ctx._handle(), ctypes.byref(d), ctypes.byref(handle))
+        self._wrap(ctx, handle)
+
+    def _wrap(self, ctx, handle, blob=None):
         _Child.__init__(self, ctx, handle)
         self._arrays = {}     # geom id -> (vertices, triangles) referenced in place
         self._sources = []    # scenes instanced here: kept alive as long as this one
+        self._blob = blob     # a loaded scene's baked map (_Blob), read in place
+
+    @classmethod
+    def _loaded(cls, ctx, handle, blob):
+        scene = cls.__new__(cls)
+        scene._wrap(ctx, handle, blob)
+        return scene
+
+    def _keepalive(self):
+        return (self._arrays, self._sources, self._blob)
 
     def close(self):
-        """Frees the scene (it must not be instanced by a live scene)."""
+        """Frees the scene (it must not be instanced by a live scene), and
+        unmaps the baked map it was loaded from."""
         if self._h is not None and self._ctx._h is not None:
             self._ctx._call("rc_scene_destroy", F.lib.rc_scene_destroy, self._h)
         self._h = None
         self._arrays = {}
         self._sources = []
+        if self._blob is not None:
+            self._blob.close()
+            self._blob = None
+
+    def bake(self, path=None):
+        """The committed scene as a baked map (docs/baked-map.md) for
+        Context.load_baked: bytes, or with path, written there through a
+        temporary file renamed into place (returns its size). The same scene
+        bakes to the same bytes on every run. The context must use the "bvh"
+        backend (the map holds its tree) and the scene hold meshes only:
+        else Error(ERR_UNSUPPORTED); not committed: Error(ERR_NOT_COMMITTED);
+        a file that cannot be written: Error(ERR_IO)."""
+        size = ctypes.c_size_t()
+        self._ctx._call("rc_scene_bake", F.lib.rc_scene_bake, self._handle(), None, 0, ctypes.byref(size))
+        blob = _aligned_empty(size.value)
+        self._ctx._call("rc_scene_bake", F.lib.rc_scene_bake, self._handle(), blob.ctypes.data, blob.size,
+                        ctypes.byref(size))
+        blob = blob[:size.value]
+        if path is None:
+            return blob.tobytes()
+        _write_replacing(os.fspath(path), blob)
+        return size.value
 
     def add_mesh(self, vertices, triangles, copy=False):
         """Adds a mesh; returns its geometry id. copy=False references the

@@ -73,6 +73,10 @@ ATTR_INST_IDS = 0x40
 
 INVALID_ID = 0xFFFFFFFF
 
+BAKED_MAP_VERSION = 1      # RC_BAKED_MAP_VERSION: the blob format the library writes and reads
+BAKED_SKIP_CHECKSUM = 1    # rc_scene_load_baked flag
+BAKED_ALIGN = 16           # rc_scene_load_baked wants the blob on a 16-byte boundary
+
 
 class Pose(ctypes.Structure):
     _fields_ = [("position", c_float * 3), ("orientation", c_float * 4)]
@@ -210,6 +214,10 @@ _PROTOTYPES = {
     "rc_scene_get_bounds": (c_i32, [_P, POINTER(c_float)]),
     "rc_scene_info_default": (SceneInfo, []),
     "rc_scene_get_info": (c_i32, [_P, POINTER(SceneInfo)]),
+    "rc_scene_bake": (c_i32, [_P, c_void_p, c_size_t, POINTER(c_size_t)]),
+    "rc_scene_baked_memory_requirements": (c_i32, [_P, c_void_p, c_size_t, POINTER(c_size_t)]),
+    "rc_scene_load_baked": (c_i32, [_P, c_void_p, c_size_t, c_u32, POINTER(_P)]),
+    "rc_baked_get_mesh": (c_i32, [c_void_p, c_size_t, c_u32, POINTER(MeshDesc), POINTER(c_u32)]),
     "rc_spherical_desc_default": (SphericalDesc, []),
     "rc_pinhole_desc_default": (PinholeDesc, []),
     "rc_cylindrical_desc_default": (CylindricalDesc, []),

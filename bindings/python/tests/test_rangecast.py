@@ -65,6 +65,25 @@ def spherical_dirs(info_theta, info_phi):
     return np.stack([np.cos(P) * np.cos(T), np.cos(P) * np.sin(T), np.sin(P)], axis=-1)
 
 
+def random_poses(n=6, dtype=np.float32, seed=3):
+    """n poses within 8 m of the origin, uniformly rotated."""
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(n, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    return np.concatenate([rng.uniform(-8, 8, (n, 3)), q], axis=1).astype(dtype)
+
+
+class StatusAssertions(object):
+    """assertStatus for a TestCase (a mixin: other test files import it)."""
+
+    def assertStatus(self, status, text, fn, *args, **kw):
+        with self.assertRaises(Error) as cm:
+            fn(*args, **kw)
+        self.assertEqual(cm.exception.status, status, str(cm.exception))
+        self.assertIn(text, str(cm.exception))
+        return cm.exception
+
+
 class Base(unittest.TestCase):
     def setUp(self):
         self.ctx = rangecast.Context(backend="bvh", threads=2)
@@ -253,10 +272,7 @@ class TestAgreement(unittest.TestCase):
             return ctx.simulate(scene, lidar, poses, ("ranges", "prim_ids", "normals"))
 
     def poses(self, n=6, dtype=np.float32):
-        rng = np.random.default_rng(3)
-        q = rng.normal(size=(n, 4))
-        q /= np.linalg.norm(q, axis=1, keepdims=True)
-        return np.concatenate([rng.uniform(-8, 8, (n, 3)), q], axis=1).astype(dtype)
+        return random_poses(n, dtype)
 
     def test_thread_count_independent(self):
         one, two = self.scan("bvh", 1, self.poses()), self.scan("bvh", 2, self.poses())
@@ -325,18 +341,11 @@ class TestThreads(Base):
         self.assertLess(self.ctx.memory_stats()["arena_used"], before)
 
 
-class TestBadInput(Base):
+class TestBadInput(StatusAssertions, Base):
     def setUp(self):
         Base.setUp(self)
         self.scene = self.ctx.mesh_scene(*plane_x(3.0))
         self.lidar = self.ctx.rays_sensor([[1, 0, 0], [0, 0, 1]], 0.1, 10.0)
-
-    def assertStatus(self, status, text, fn, *args, **kw):
-        with self.assertRaises(Error) as cm:
-            fn(*args, **kw)
-        self.assertEqual(cm.exception.status, status, str(cm.exception))
-        self.assertIn(text, str(cm.exception))
-        return cm.exception
 
     def test_bad_poses_write_nothing(self):
         out = {"ranges": np.full((2, 1, 2), 42.0, np.float32)}
