@@ -203,6 +203,12 @@ int main(int argc, char **argv)
     F(rc_noise_desc, reserved);
     end();
 
+    S(rc_ouster_desc);
+    F(rc_ouster_desc, struct_size); F(rc_ouster_desc, beams); F(rc_ouster_desc, columns);
+    F(rc_ouster_desc, reserved0); F(rc_ouster_desc, altitudes_deg); F(rc_ouster_desc, azimuths_deg);
+    F(rc_ouster_desc, beam_to_lidar); F(rc_ouster_desc, lidar_to_sensor); F(rc_ouster_desc, reserved);
+    end();
+
     S(rc_results);
     F(rc_results, struct_size); F(rc_results, attributes); F(rc_results, capacity); F(rc_results, hits);
     F(rc_results, ranges); F(rc_results, points); F(rc_results, normals); F(rc_results, prim_ids);

@@ -607,6 +607,48 @@ RC_API rc_status rc_preset_rays(uint32_t preset, rc_rays_desc *desc, float *dire
 RC_API rc_status rc_sensor_create_preset(rc_context *ctx, uint32_t preset, rc_sensor **out);
 RC_API rc_status rc_sensor_memory_requirements_preset(uint32_t preset, size_t *bytes);
 
+/* Ouster lidars from their beam intrinsics: what an Ouster sensor reports
+ * about itself (its metadata JSON, or the SDK's sensor_info), as the rays of
+ * an OnDn sensor whose every ray leaves its own beam origin. For beam
+ * u < beams and measurement id v < columns (ray u * columns + v: the sensor's
+ * own, staggered, order; rows are beams):
+ *   encoder      te = 2 pi (1 - v / columns)     (the rotor turns clockwise seen from above)
+ *   azimuth      ta = -azimuths_deg[u]; altitude p = altitudes_deg[u]   (to radians)
+ *   direction       = (cos(te + ta) cos p, sin(te + ta) cos p, sin p)   (lidar frame)
+ *   beam origin     = (bx cos te, bx sin te, bz)    bx = beam_to_lidar[3], bz = beam_to_lidar[11]
+ * both taken through lidar_to_sensor into the sensor frame, millimetres to
+ * metres. Simulated points are then where the sensor puts them. The sensor
+ * measures range from the lidar axis, not from the beam origin: add
+ * beam_offset_m = sqrt(bx^2 + bz^2) / 1000 to a simulated range to get the
+ * range it reports. Older metadata gives lidar_origin_to_beam_origin_mm
+ * instead of beam_to_lidar: that is bx, with bz = 0. */
+typedef struct rc_ouster_desc {
+    uint32_t struct_size;
+    uint32_t beams;                /* pixels_per_column (16, 32, 64, 128) */
+    uint32_t columns;              /* columns_per_frame (512, 1024, 2048) */
+    uint32_t reserved0;
+    const double *altitudes_deg;   /* beam_altitude_angles: one per beam */
+    const double *azimuths_deg;    /* beam_azimuth_angles: one per beam */
+    double beam_to_lidar[16];      /* 4x4 row by row, translation in mm; default identity */
+    double lidar_to_sensor[16];    /* 4x4 row by row, translation in mm; default Ouster's
+                                      (180 degrees about z, 36.18 mm up) */
+    uint32_t reserved[8];
+} rc_ouster_desc;
+
+RC_API rc_ouster_desc rc_ouster_desc_default(void);
+
+/* Writes the beams * columns rays: origins and directions, 3 floats each
+ * (metres; unit vectors), and fills rays (may be NULL) for
+ * rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, rays, ...): pointing at the two
+ * arrays, shaped beams x columns, range 0.3 .. 120 m (an OS1's; set your
+ * model's). beam_offset_m (may be NULL) gets the beam offset above. Checks:
+ * counts of at least 1 with at most 2^24 rays, finite angles and matrices,
+ * rigid 3x3 parts (orthonormal within 1e-6, no mirror), non-NULL arrays:
+ * RC_ERR_INVALID_ARGUMENT or RC_ERR_NON_FINITE, nothing written. No context:
+ * statuses only. Thread-safe. */
+RC_API rc_status rc_ouster_rays(const rc_ouster_desc *desc, rc_rays_desc *rays, float *origins, float *directions,
+                                double *beam_offset_m);
+
 /* Shape of a sensor's scan. */
 typedef struct rc_sensor_info {
     uint32_t struct_size;

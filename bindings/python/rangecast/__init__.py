@@ -20,7 +20,8 @@ metres, radians, quaternions x y z w, base-to-map poses, REP 117 ranges.
 
 from ._api import (ATTRIBUTES, INVALID_ID, Context, Error, Scene, Sensor, backend_available,
                    quaternion_from_euler, version)
+from . import ouster  # noqa: E402  (Ouster lidars from their metadata JSON)
 
-__all__ = ["ATTRIBUTES", "INVALID_ID", "Context", "Error", "Scene", "Sensor", "backend_available",
+__all__ = ["ATTRIBUTES", "INVALID_ID", "Context", "Error", "Scene", "Sensor", "backend_available", "ouster",
            "quaternion_from_euler", "version"]
 __version__ = version()

@@ -166,6 +166,12 @@ class NoiseDesc(ctypes.Structure):
                 ("sigma_exponent", c_float), ("dropout", c_float), ("seed", c_u64), ("reserved", c_u32 * 8)]
 
 
+class OusterDesc(ctypes.Structure):
+    _fields_ = [("struct_size", c_u32), ("beams", c_u32), ("columns", c_u32), ("reserved0", c_u32),
+                ("altitudes_deg", POINTER(c_double)), ("azimuths_deg", POINTER(c_double)),
+                ("beam_to_lidar", c_double * 16), ("lidar_to_sensor", c_double * 16), ("reserved", c_u32 * 8)]
+
+
 class Results(ctypes.Structure):
     _fields_ = [("struct_size", c_u32), ("attributes", c_u32), ("capacity", c_u64), ("hits", POINTER(c_u8)),
                 ("ranges", POINTER(c_float)), ("points", POINTER(c_float)), ("normals", POINTER(c_float)),
@@ -180,6 +186,7 @@ STRUCTS = {
     "rc_scene_info": SceneInfo, "rc_sensor_common": SensorCommon, "rc_angle_axis": AngleAxis,
     "rc_spherical_desc": SphericalDesc, "rc_pinhole_desc": PinholeDesc, "rc_cylindrical_desc": CylindricalDesc,
     "rc_rays_desc": RaysDesc, "rc_sensor_info": SensorInfo, "rc_noise_desc": NoiseDesc, "rc_results": Results,
+    "rc_ouster_desc": OusterDesc,
 }
 
 _P = c_void_p  # opaque handles (rc_context *, rc_scene *, rc_sensor *)
@@ -233,6 +240,9 @@ _PROTOTYPES = {
     "rc_sensor_info_default": (SensorInfo, []),
     "rc_sensor_get_info": (c_i32, [_P, POINTER(SensorInfo)]),
     "rc_sensor_set_mounting": (c_i32, [_P, POINTER(Pose)]),
+    "rc_ouster_desc_default": (OusterDesc, []),
+    "rc_ouster_rays": (c_i32, [POINTER(OusterDesc), POINTER(RaysDesc), POINTER(c_float), POINTER(c_float),
+                               POINTER(c_double)]),
     "rc_noise_desc_default": (NoiseDesc, []),
     "rc_sensor_set_noise": (c_i32, [_P, POINTER(NoiseDesc)]),
     "rc_results_default": (Results, []),
