@@ -10,7 +10,7 @@ set -eu
 
 profile=${1:-demo}
 base="build-essential cmake pkg-config"
-demo="$base libpng-dev libassimp-dev libmeshoptimizer-dev"
+demo="$base libpng-dev libassimp-dev libmeshoptimizer-dev libcjson-dev"
 # python3-matplotlib: tools/chart.py (make accuracy-docs); python3-numpy: the
 # Python binding and its tests (bindings/python)
 test="$demo python3-matplotlib python3-numpy libcmocka-dev libembree-dev libvulkan-dev mesa-vulkan-drivers glslang-tools clang valgrind"

@@ -10,6 +10,7 @@ RC=$1
 WORK=$2
 shift 2
 BACKEND=${*:-}
+DATA=$(cd "$(dirname "$0")/../data" && pwd)
 . "$(dirname "$0")/common.sh"
 
 run 0 "" "$RC" gen --sphere 1k --radius 20 -o sphere.ply
@@ -216,4 +217,35 @@ run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bi
 for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
 done
+# An Ouster unit from its metadata (--sensor ouster:FILE, rc_ouster_rays): 16
+# beams x 512 measurement ids from the sphere's centre. Every point lies on the
+# sphere (|point| is measured from the sensor origin) and its range, measured
+# from its beam origin 4 cm off that origin, within 4 cm of |point|; beam 0
+# (ring 0) looks 15 degrees up. Bad metadata: exit 1 naming the problem.
+if "$RC" simulate --map sphere.ply --pose 0,0,0 -o ouster.pcd --ascii --fields range,ring \
+    --sensor "ouster:$DATA/ouster_os1_16.json" $BACKEND >out.txt 2>err.txt; then
+    grep -qx "POINTS 8192" ouster.pcd || fail "Ouster PCD point count"
+    awk 'f {
+            n++
+            r = sqrt($1 * $1 + $2 * $2 + $3 * $3)
+            if (r < 19.5 || r > 20.0001) { print "|point| " r " off the sphere"; bad = 1 }
+            if (r - $4 > 0.04 || $4 - r > 0.04) { print "range " $4 " against |point| " r; bad = 1 }
+            if ($5 == 0 && $3 < 0.2 * r) { print "beam 0 not looking up: z " $3; bad = 1 }
+            ring[$5]++
+         }
+         /^DATA/ { f = 1 }
+         END {
+            for (k = 0; k < 16; k++) if (ring[k] != 512) { print "ring " k ": " ring[k] " points"; bad = 1 }
+            exit bad
+         }' ouster.pcd || fail "ouster.pcd contents"
+    echo '{"lidar_mode": "512x10"}' >no_beams.json
+    run 1 "beam_altitude_angles" "$RC" simulate --map sphere.ply --pose 0,0,0 -o p.pcd --sensor ouster:no_beams.json
+    echo '[1, 2]' >array.json
+    run 1 "not a JSON object" "$RC" simulate --map sphere.ply --pose 0,0,0 -o q.pcd --sensor ouster:array.json
+    run 1 "cannot read it" "$RC" bench --triangles 1k --pose-count 1 --sensor ouster:missing.json
+    [ ! -e p.pcd ] && [ ! -e q.pcd ] || fail "a run on bad Ouster metadata wrote a cloud"
+else
+    grep -q "without cJSON" err.txt || { cat err.txt >&2; fail "simulate --sensor ouster:FILE"; }
+    echo "check_simulate: this rangecast has no cJSON: the Ouster checks are skipped"
+fi
 echo "check_simulate: all checks passed"

@@ -9,6 +9,7 @@
 
 #include "baked_file.h"
 #include "mesh_load.h"
+#include "ouster_json.h"
 #include "poses.h"
 #include "reference.h"
 #include "tool.h"
@@ -46,7 +47,8 @@ static void usage(FILE *f)
         "  --poses FILE       raw poses: float32 LE x y z qx qy qz qw per pose\n"
         "  --sensor NAME      vlp16 (default), vlp16-360, os1-64, d435, livox-mid40;\n"
         "                     random-ondn: 14,400 incoherent OnDn rays (origins in a 5 m ball,\n"
-        "                     random directions, fixed layout), the ray order for --ranges-out\n"
+        "                     random directions, fixed layout), the ray order for --ranges-out\n"        "                     ouster:FILE.json: an Ouster unit from its metadata (rc_ouster_rays;\n"
+        "                     each ray from its beam origin, 0.3 .. 120 m)\n"
         "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
         "  --device NAME      vulkan: device index or name substring (default: first GPU, else any)\n"
         "  --build-quality Q  balanced (default), fast, high, compact: rc_scene_desc.build_quality\n"
@@ -181,28 +183,32 @@ typedef struct bench_args {
     const char *sensor_name;
     int set_triangles, set_pose_count, set_seed;
     int embree_single; /* --backend embree-single: the hand-written rtcIntersect1 loop */
-    int ondn;          /* --sensor random-ondn */
+    int ondn;          /* --sensor random-ondn or ouster:FILE: an OnDn sensor of the bench's rays */
+    const char *ouster_path; /* --sensor ouster:FILE */
 } bench_args;
 
-/* The rays of --sensor random-ondn (sensor frame). */
-typedef struct bench_ondn {
-    float origins[3 * BENCH_ONDN_RAYS];
-    float dirs[3 * BENCH_ONDN_RAYS];
-} bench_ondn;
-
-static bench_ondn *ondn_make(void)
+/* The rays of --sensor random-ondn (sensor frame); 0 or -1 (out of memory). */
+static int random_rays(rcp_rays *r)
 {
-    bench_ondn *r = (bench_ondn *)malloc(sizeof *r);
-    if (r) rcu_rays_random(BENCH_ONDN_RAYS, BENCH_ONDN_RADIUS, BENCH_ONDN_SEED, r->origins, r->dirs);
-    return r;
+    memset(r, 0, sizeof *r);
+    r->origins = (float *)malloc(sizeof(float) * 3u * BENCH_ONDN_RAYS);
+    r->dirs = (float *)malloc(sizeof(float) * 3u * BENCH_ONDN_RAYS);
+    if (!r->origins || !r->dirs) {
+        rcp_rays_free(r);
+        return -1;
+    }
+    rcu_rays_random(BENCH_ONDN_RAYS, BENCH_ONDN_RADIUS, BENCH_ONDN_SEED, r->origins, r->dirs);
+    r->count = r->width = BENCH_ONDN_RAYS;
+    r->height = 1;
+    r->range_min = BENCH_ONDN_RANGE_MIN;
+    r->range_max = BENCH_ONDN_RANGE_MAX;
+    return 0;
 }
 
 /* The float64 reference rays of the bench's sensor. */
-static int bench_reference(const bench_args *a, const bench_ondn *ondn, rcu_preset_rays *ref)
+static int bench_reference(const bench_args *a, const rcp_rays *ondn, rcu_preset_rays *ref)
 {
-    if (a->ondn)
-        return rcu_rays_f64(ondn->origins, ondn->dirs, BENCH_ONDN_RAYS, BENCH_ONDN_RANGE_MIN, BENCH_ONDN_RANGE_MAX,
-                            ref);
+    if (a->ondn) return rcu_rays_f64(ondn->origins, ondn->dirs, ondn->count, ondn->range_min, ondn->range_max, ref);
     return rcu_preset_rays_f64(a->preset, ref);
 }
 
@@ -229,10 +235,16 @@ static int parse_args(int argc, char **argv, bench_args *a)
         else if (OPT("--ranges-out")) { if (r < 0) return -1; a->ranges_out = v; }
         else if (OPT("--sensor")) {
             if (r < 0) return -1;
+            a->ouster_path = NULL;
+            a->ondn = 0;
             if (strcmp(v, "random-ondn") == 0) {
                 a->ondn = 1;
+            } else if (strncmp(v, RCP_OUSTER_PREFIX, strlen(RCP_OUSTER_PREFIX)) == 0) {
+                a->ondn = 1;
+                a->ouster_path = v + strlen(RCP_OUSTER_PREFIX);
             } else if (rcp_parse_sensor(cmd, v, &a->preset) != 0) {
-                fprintf(stderr, "rangecast bench: (bench also takes random-ondn: incoherent OnDn rays)\n");
+                fprintf(stderr, "rangecast bench: (bench also takes random-ondn: incoherent OnDn rays, and "
+                                "ouster:FILE.json)\n");
                 return -1;
             }
             a->sensor_name = v;
@@ -295,7 +307,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
  * (tools/rangecast/embree_single.c), timed the same way, printed with the same
  * keys. Accuracy keys that need triangle ids are null; hit_mismatch counts
  * escaped rays on the generated sphere. */
-static int bench_embree_single(const bench_args *a, const bench_ondn *ondn, const rcu_mesh *mesh,
+static int bench_embree_single(const bench_args *a, const rcp_rays *ondn, const rcu_mesh *mesh,
                                const rc_pose *poses, uint32_t pose_count, int is_sphere)
 {
     const char *cmd = "bench";
@@ -352,7 +364,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc_pose *poses = NULL;
     uint32_t pose_count = 0, rays, batch, chunk, p, rep;
     rcp_world w;
-    bench_ondn *ondn = NULL;
+    rcp_rays ondn;
     rc_sensor_info si = rc_sensor_info_default();
     rc_scene_info scinfo = rc_scene_info_default();
     rc_memory_stats ms = rc_memory_stats_default();
@@ -375,6 +387,7 @@ int rcp_cmd_bench(int argc, char **argv)
     memset(&w, 0, sizeof w);
     memset(&ref, 0, sizeof ref);
     memset(&acc, 0, sizeof acc);
+    memset(&ondn, 0, sizeof ondn);
 
     /* The map. */
     if (is_sphere) {
@@ -384,7 +397,11 @@ int rcp_cmd_bench(int argc, char **argv)
         return rcp_fail(cmd, "%s", rcu_last_error());
     }
 
-    if (a.ondn && !(ondn = ondn_make())) {
+    if (a.ouster_path && rcp_ouster_load(a.ouster_path, &ondn) != 0) {
+        rcp_fail(cmd, "%s", rcu_last_error());
+        goto done;
+    }
+    if (a.ondn && !a.ouster_path && random_rays(&ondn) != 0) {
         rcp_fail(cmd, "out of memory for the OnDn rays");
         goto done;
     }
@@ -413,17 +430,12 @@ int rcp_cmd_bench(int argc, char **argv)
 
 #if defined(RANGECAST_TOOL_WITH_EMBREE)
     if (a.embree_single) {
-        rc = bench_embree_single(&a, ondn, &mesh, poses, pose_count, is_sphere);
+        rc = bench_embree_single(&a, &ondn, &mesh, poses, pose_count, is_sphere);
         goto done;
     }
 #endif
     if (a.ondn) {
-        rc_rays_desc rd = rc_rays_desc_default();
-        rd.common.range_min = BENCH_ONDN_RANGE_MIN;
-        rd.common.range_max = BENCH_ONDN_RANGE_MAX;
-        rd.directions = ondn->dirs;
-        rd.origins = ondn->origins;
-        rd.ray_count = BENCH_ONDN_RAYS;
+        const rc_rays_desc rd = rcp_rays_desc(&ondn);
         if (rcp_world_create_rays(cmd, a.backend, a.threads, &mesh, RC_SENSOR_ONDN, &rd, &w) != RCP_EXIT_OK)
             goto done;
     } else if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) {
@@ -485,7 +497,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc_context_get_memory_stats(w.ctx, &ms);
 
     /* ---- accuracy pass (untimed) ---- */
-    if (bench_reference(&a, ondn, &ref) != 0) {
+    if (bench_reference(&a, &ondn, &ref) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
         goto done;
     }
@@ -665,7 +677,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rc = RCP_EXIT_OK;
 
 done:
-    free(ondn);
+    rcp_rays_free(&ondn);
     if (rout) fclose(rout);
     /* a failed run leaves no half-written ranges behind */
     if (rc != RCP_EXIT_OK && a.ranges_out && rout_opened) rcu_remove_partial(a.ranges_out);

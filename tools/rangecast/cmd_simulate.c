@@ -8,6 +8,7 @@
 
 #include "cloud.h"
 #include "mesh_load.h"
+#include "ouster_json.h"
 #include "poses.h"
 #include "range_image.h"
 #include "reference.h"
@@ -28,7 +29,10 @@ static void usage(FILE *f)
         "  --map FILE          mesh map (%s)\n"
         "  --poses FILE        raw poses: float32 LE x y z qx qy qz qw per pose\n"
         "  --pose P            one pose, x,y,z,qx,qy,qz,qw (quaternion optional: x,y,z)\n"
-        "  --sensor NAME       vlp16 (default), vlp16-360, os1-64, d435, livox-mid40\n"
+        "  --sensor NAME       vlp16 (default), vlp16-360, os1-64, d435, livox-mid40;\n"
+        "                      ouster:FILE.json: an Ouster unit from its metadata (rc_ouster_rays: each\n"
+        "                      ray from its beam origin; rows are beams, columns measurement ids;\n"
+        "                      range is from the beam origin, 0.3 .. 120 m)\n"
         "  --backend B         auto (default), bvh, embree, vulkan\n"
         "  --threads N         worker threads, 0 = all CPUs (default)\n"
         "  -o, --output OUT    .ply or .pcd (binary unless --ascii)\n"
@@ -49,6 +53,7 @@ static void usage(FILE *f)
 
 typedef struct sim_args {
     const char *map, *poses_path, *out, *image, *sensor_name;
+    const char *ouster_path; /* --sensor ouster:FILE, else NULL */
     int have_pose, ascii, map_frame;
     rc_pose pose;
     uint32_t preset, backend, threads, fields, image_mode;
@@ -131,7 +136,15 @@ static int parse_args(int argc, char **argv, sim_args *a)
             }
             a->have_pose = 1;
         } else if (OPT("--sensor")) {
-            if (r < 0 || rcp_parse_sensor(cmd, v, &a->preset) != 0) return -1;
+            if (r < 0) return -1;
+            if (strncmp(v, RCP_OUSTER_PREFIX, strlen(RCP_OUSTER_PREFIX)) == 0) {
+                a->ouster_path = v + strlen(RCP_OUSTER_PREFIX);
+                a->preset = 0;
+            } else if (rcp_parse_sensor(cmd, v, &a->preset) != 0) {
+                return -1;
+            } else {
+                a->ouster_path = NULL;
+            }
             a->sensor_name = v;
         } else if (OPT("--backend")) {
             if (r < 0 || rcp_parse_backend(cmd, v, &a->backend) != 0) return -1;
@@ -188,7 +201,7 @@ static int parse_args(int argc, char **argv, sim_args *a)
         if (strcmp(ext, "ply") != 0 && strcmp(ext, "pcd") != 0)
             return rcp_usage_error(cmd, "-o %s: the point cloud must be .ply or .pcd", a->out), -1;
     }
-    if (a->preset == 0) a->preset = rc_preset_from_name(a->sensor_name);
+    if (a->preset == 0 && !a->ouster_path) a->preset = rc_preset_from_name(a->sensor_name);
     return 0;
 }
 
@@ -226,6 +239,7 @@ int rcp_cmd_simulate(int argc, char **argv)
     rc_sensor_info si = rc_sensor_info_default();
     rcu_cloud cloud;
     rcu_preset_rays ref;
+    rcp_rays ou;
     float *points = NULL, *ranges = NULL, *normals = NULL;
     uint8_t *hits = NULL;
     double t_sim = 0.0;
@@ -235,6 +249,7 @@ int rcp_cmd_simulate(int argc, char **argv)
     if (parse_args(argc, argv, &a) != 0) return RCP_EXIT_USAGE;
     memset(&w, 0, sizeof w);
     memset(&ref, 0, sizeof ref);
+    memset(&ou, 0, sizeof ou);
     rcu_cloud_init(&cloud, a.fields);
     if (rcp_mesh_load(a.map, &mesh) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
     if (a.poses_path) {
@@ -248,7 +263,18 @@ int rcp_cmd_simulate(int argc, char **argv)
         poses[0] = a.pose;
         pose_count = 1;
     }
-    if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) goto done;
+    if (a.ouster_path) {
+        rc_rays_desc rd;
+        if (rcp_ouster_load(a.ouster_path, &ou) != 0) {
+            rcp_fail(cmd, "%s", rcu_last_error());
+            goto done;
+        }
+        rd = rcp_rays_desc(&ou);
+        if (rcp_world_create_rays(cmd, a.backend, a.threads, &mesh, RC_SENSOR_ONDN, &rd, &w) != RCP_EXIT_OK)
+            goto done;
+    } else if (rcp_world_create(cmd, a.backend, a.threads, &mesh, &a.preset, 1, &w) != RCP_EXIT_OK) {
+        goto done;
+    }
     {
         /* the library judges the values: its message names the field */
         const rc_status st = rc_sensor_set_noise(w.sensors[0], &a.noise);
@@ -260,7 +286,8 @@ int rcp_cmd_simulate(int argc, char **argv)
     }
     rc_sensor_get_info(w.sensors[0], &si);
     rays = si.rays_per_scan;
-    if (rcu_preset_rays_f64(a.preset, &ref) != 0) {
+    if ((a.ouster_path ? rcu_rays_f64(ou.origins, ou.dirs, ou.count, ou.range_min, ou.range_max, &ref)
+                       : rcu_preset_rays_f64(a.preset, &ref)) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
         goto done;
     }
@@ -329,6 +356,7 @@ int rcp_cmd_simulate(int argc, char **argv)
 done:
     rcp_world_destroy(&w);
     rcu_preset_rays_free(&ref);
+    rcp_rays_free(&ou);
     rcu_cloud_free(&cloud);
     free(points);
     free(ranges);

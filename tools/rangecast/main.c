@@ -29,7 +29,7 @@ static void usage(FILE *f)
         "  help       this text ('rangecast COMMAND --help' for a command's options)\n"
         "\n"
         "Backends in this library: %s (auto picks embree when present, else bvh).\n"
-        "Sensors: vlp16, vlp16-360, os1-64, d435, livox-mid40.\n"
+        "Sensors: vlp16, vlp16-360, os1-64, d435, livox-mid40; ouster:FILE.json (an Ouster unit's metadata).\n"
         "Maps: %s.\n"
         "Images: %s.\n"
         "Exit status: 0 success, 1 a library or file error, 2 bad arguments.\n",
