@@ -4,8 +4,9 @@
  * the library must answer each call with a known status, never crash or
  * overrun (the suite runs under ASan+UBSan and valgrind), and what it
  * returns RC_OK for must hold up: simulate then writes only hits of 0 or 1
- * and ranges that are +inf, -inf or inside the sensor's range. Seeded, so a
- * failure replays. */
+ * and ranges that are +inf, -inf or inside the sensor's range. Baked maps
+ * (now and then damaged, or loaded from too few bytes) and Ouster sensors
+ * (rc_ouster_rays) take part. Seeded, so a failure replays. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -108,7 +109,7 @@ static rc_sensor *any_sensor(rc_context *ctx, const float *dirs, const float *or
 {
     rc_sensor *s = NULL;
     rc_status st;
-    switch (below(5)) {
+    switch (below(6)) {
     case 0: {
         rc_spherical_desc d = rc_spherical_desc_default();
         fill_common(&d.common);
@@ -145,6 +146,33 @@ static rc_sensor *any_sensor(rc_context *ctx, const float *dirs, const float *or
         d.fy = any_float(-10.0f, 20.0f);
         d.cy = any_float(-5.0f, 10.0f);
         st = rc_sensor_create_cylindrical(ctx, &d, &s);
+        break;
+    }
+    case 4: {
+        /* an Ouster unit: counts stay within these arrays unless they are
+         * ones rc_ouster_rays must refuse (0, or past 2^24 rays) */
+        double alt[4], azi[4];
+        float o[3 * 32], dd[3 * 32];
+        rc_ouster_desc od = rc_ouster_desc_default();
+        rc_rays_desc d;
+        uint32_t k;
+        od.beams = hostile() ? (below(2) ? 0u : 0xFFFFFFFFu) : 1u + below(4);
+        od.columns = hostile() ? (below(2) ? 0u : 0x40000000u) : 1u + below(8);
+        for (k = 0; k < 4; ++k) {
+            alt[k] = any_float(-45.0f, 45.0f);
+            azi[k] = any_float(-5.0f, 5.0f);
+        }
+        od.altitudes_deg = hostile() ? NULL : alt;
+        od.azimuths_deg = azi;
+        od.beam_to_lidar[3] = any_float(0.0f, 30.0f);
+        od.lidar_to_sensor[below(16)] += hostile() ? any_float(-1.0f, 1.0f) : 0.0f;
+        od.reserved[7] = any_word();
+        st = rc_ouster_rays(&od, &d, o, dd, NULL);
+        if (!known_status(st)) fail_msg("rc_ouster_rays returned %d (seed %lu)", (int)st, seed);
+        if (st == RC_OK) {
+            fill_common(&d.common);
+            st = rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &s);
+        }
         break;
     }
     case 3:
@@ -185,7 +213,8 @@ static void one_round(unsigned long seed, uint32_t backend)
     static uint32_t ids[3][MAX_POSES * 4096];
     rc_context_desc cd = rc_context_desc_default();
     rc_context *ctx = NULL;
-    rc_scene *mesh_scene = NULL, *world = NULL;
+    rc_scene *mesh_scene = NULL, *world = NULL, *baked = NULL;
+    unsigned char *blob = NULL;
     rc_sensor *sensor = NULL;
     rc_scene_desc sd = rc_scene_desc_default();
     rc_mesh_desc md = rc_mesh_desc_default();
@@ -251,6 +280,21 @@ static void one_round(unsigned long seed, uint32_t backend)
         if (!known_status(st)) fail_msg("rc_scene_commit returned %d (seed %lu)", (int)st, seed);
         reached[1] += st == RC_OK;
     }
+    /* sometimes the mesh baked and loaded back, now and then with a byte
+     * changed and the checksum check skipped */
+    if (mesh_scene && below(4) == 0) {
+        size_t need = 0, wrote = 0;
+        st = rc_scene_bake(mesh_scene, NULL, 0, &need);
+        if (!known_status(st)) fail_msg("rc_scene_bake returned %d (seed %lu)", (int)st, seed);
+        if (st == RC_OK) {
+            blob = (unsigned char *)rct_alloc16(need);
+            CHECK_STATUS(rc_scene_bake(mesh_scene, blob, hostile() ? need - 1u : need, &wrote));
+            if (hostile()) blob[below((uint32_t)need)] ^= (unsigned char)(1u + below(255));
+            st = rc_scene_load_baked(ctx, blob, hostile() ? need - 64u : need,
+                                     hostile() ? next_u32() : below(2) * RC_BAKED_SKIP_CHECKSUM, &baked);
+            if (!known_status(st)) fail_msg("rc_scene_load_baked returned %d (seed %lu)", (int)st, seed);
+        }
+    }
     /* sometimes a world of instances of it */
     if (mesh_scene && below(3) == 0) {
         rc_scene_desc wd = rc_scene_desc_default();
@@ -290,7 +334,7 @@ static void one_round(unsigned long seed, uint32_t backend)
     reached[3] += sensor != NULL;
 
     if (sensor) {
-        const rc_scene *target = world && below(2) ? world : mesh_scene;
+        const rc_scene *target = world && below(2) ? world : baked && below(2) ? baked : mesh_scene;
         RCT_OK(ctx, rc_sensor_get_info(sensor, &info));
         n_poses = 1u + below(MAX_POSES);
         for (i = 0; i < n_poses; ++i) any_pose(&poses[i], 3.0f);
@@ -345,6 +389,7 @@ static void one_round(unsigned long seed, uint32_t backend)
         fprintf(stderr, "  reached: mesh %d world %d sensor %d simulate %d (%s)\n", mesh_scene != NULL, world != NULL,
                 sensor != NULL, (int)st, rc_context_last_error(ctx));
     rc_context_destroy(ctx);
+    free(blob); /* after the scene that referenced it */
 }
 
 static void fuzz(uint32_t backend)
