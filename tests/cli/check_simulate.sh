@@ -238,6 +238,17 @@ if "$RC" simulate --map sphere.ply --pose 0,0,0 -o ouster.pcd --ascii --fields r
             for (k = 0; k < 16; k++) if (ring[k] != 512) { print "ring " k ": " ring[k] " points"; bad = 1 }
             exit bad
          }' ouster.pcd || fail "ouster.pcd contents"
+    # the flat legacy layout: two level beams, 4 columns, no beam offset, the
+    # lidar frame as the sensor frame: every point 20 m away in the x-y plane
+    cat >legacy.json <<'EOF'
+{"beam_altitude_angles": [0.0, 0.0], "beam_azimuth_angles": [0.0, 45.0], "lidar_mode": "4x10",
+ "lidar_origin_to_beam_origin_mm": 0.0, "lidar_to_sensor_transform": [1,0,0,0, 0,1,0,0, 0,0,1,0, 0,0,0,1]}
+EOF
+    run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o legacy.pcd --ascii --fields range,ring \
+        --sensor ouster:legacy.json $BACKEND
+    grep -qx "POINTS 8" legacy.pcd || fail "legacy Ouster metadata: point count"
+    awk 'f { if ($3 > 1e-4 || $3 < -1e-4 || $4 < 19.5 || $4 > 20.0001) { print "legacy point " $0; bad = 1 } }
+         /^DATA/ { f = 1 } END { exit bad }' legacy.pcd || fail "legacy.pcd contents"
     echo '{"lidar_mode": "512x10"}' >no_beams.json
     run 1 "beam_altitude_angles" "$RC" simulate --map sphere.ply --pose 0,0,0 -o p.pcd --sensor ouster:no_beams.json
     echo '[1, 2]' >array.json
