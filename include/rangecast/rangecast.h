@@ -564,7 +564,10 @@ RC_API rc_pinhole_desc rc_pinhole_desc_default(void);
 RC_API rc_cylindrical_desc rc_cylindrical_desc_default(void);
 RC_API rc_rays_desc rc_rays_desc_default(void);
 
-/* Exact arena bytes a sensor takes (its precomputed ray table). */
+/* Exact arena bytes a sensor takes (its precomputed ray table; O1Dn and OnDn
+ * sensors also keep the order the CPU backends trace their rays in, 8 bytes a
+ * ray, made at create: rays sorted by direction and origin so neighbours in a
+ * run are near each other; it changes the speed, never a result). */
 RC_API rc_status rc_sensor_memory_requirements_spherical(const rc_spherical_desc *desc, size_t *bytes);
 RC_API rc_status rc_sensor_memory_requirements_pinhole(const rc_pinhole_desc *desc, size_t *bytes);
 RC_API rc_status rc_sensor_memory_requirements_cylindrical(const rc_cylindrical_desc *desc, size_t *bytes);

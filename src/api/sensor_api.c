@@ -1,7 +1,8 @@
 /* Public sensor functions: descriptor defaults, size queries, create/destroy,
  * info, mounting. A sensor is one arena allocation: the struct, then the
- * direction table, then (OnDn) the origin table, each at a 16-aligned offset,
- * so rc__sensor_bytes is exactly the arena cost of that one block. */
+ * direction table, then (OnDn) the origin table, then (O1Dn, OnDn) the trace
+ * order, each at a 16-aligned offset, so rc__sensor_bytes is exactly the
+ * arena cost of that one block. */
 #include "sensor/sensor.h"
 
 #include <math.h>
@@ -14,6 +15,7 @@
 typedef struct sensor_layout {
     size_t directions; /* offset of the direction table */
     size_t origins;    /* offset of the origin table (OnDn), else 0 */
+    size_t order;      /* offset of the trace order (O1Dn, OnDn), else 0 */
     size_t total;      /* bytes of the one allocation */
 } sensor_layout;
 
@@ -24,7 +26,7 @@ static int sensor_layout_of(uint32_t model, uint64_t rays, sensor_layout *out)
 {
     const uint64_t table = align16(rays * 12u); /* 3 floats a ray */
     uint64_t total = align16(sizeof(struct rc_sensor));
-    uint64_t origins = 0;
+    uint64_t origins = 0, order = 0;
     const uint64_t dirs = total;
     if (rays > UINT32_MAX) return 0;
     total += table;
@@ -32,10 +34,15 @@ static int sensor_layout_of(uint32_t model, uint64_t rays, sensor_layout *out)
         origins = total;
         total += table;
     }
+    if (model == RC_SENSOR_O1DN || model == RC_SENSOR_ONDN) {
+        order = total;
+        total += align16(rays * 8u);
+    }
     /* leave room for the arena's header and rounding */
     if (total > (uint64_t)((size_t)-1) - 4u * RC__ARENA_ALIGN) return 0;
     out->directions = (size_t)dirs;
     out->origins = (size_t)origins;
+    out->order = (size_t)order;
     out->total = (size_t)total;
     return 1;
 }
@@ -219,12 +226,16 @@ static rc_status sensor_make(rc_context *ctx, uint32_t model, uint32_t rows, uin
     rc__xform_from_pose(&s->mount, &s->mount_xform);
     s->directions = (float *)(void *)(mem + l.directions);
     s->origins = model == RC_SENSOR_ONDN ? (float *)(void *)(mem + l.origins) : NULL;
+    s->trace_order = l.order ? (uint64_t *)(void *)(mem + l.order) : NULL;
     *out = s;
     return RC_OK;
 }
 
+/* Links a filled sensor into its context (sorting an O1Dn/OnDn sensor's
+ * rays first: their tables are complete now). */
 static void sensor_link(rc_context *ctx, rc_sensor *s)
 {
+    if (s->trace_order) rc__sensor_order_rays(s);
     s->next = ctx->sensors;
     ctx->sensors = s;
 }

@@ -179,7 +179,7 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
             n[k] = 0;
             for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
                 for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b)
-                    idx[k][n[k]++] = (r0 + a) * sensor->columns + c0 + b;
+                    idx[k][n[k]++] = rc__sensor_traced_ray(sensor, (r0 + a) * sensor->columns + c0 + b);
             for (i = 0; i < n[k]; ++i) {
                 const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
                 world_ray(&world, sensor->directions + (size_t)idx[k][i] * 3u, os, &rays[k][i]);

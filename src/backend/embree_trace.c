@@ -72,8 +72,9 @@ static inline void tile_rays(const trace_run *run, uint32_t tile, uint32_t *ray)
     uint32_t r, c, l = 0;
     for (r = 0; r < run->tile_rows; ++r)
         for (c = 0; c < run->tile_cols; ++c, ++l)
-            ray[l] = (row0 + r < run->grid_rows && col0 + c < run->grid_cols) ? (row0 + r) * run->grid_cols + col0 + c
-                                                                               : RC_INVALID_ID;
+            ray[l] = (row0 + r < run->grid_rows && col0 + c < run->grid_cols)
+                         ? rc__sensor_traced_ray(run->job->sensor, (row0 + r) * run->grid_cols + col0 + c)
+                         : RC_INVALID_ID;
 }
 
 /* Ray r of the scan in the map frame. */

@@ -19,6 +19,11 @@ struct rc_sensor {
     rc__xform mount_xform;
     float *directions;       /* 3 * rays, unit, sensor frame, in scan order */
     float *origins;          /* 3 * rays for OnDn, else NULL */
+    /* O1Dn/OnDn: the order the CPU backends trace the rays in (ray index in
+     * the low 32 bits, its key above: ray_order.c), so that neighbours in a
+     * run leave from near each other in near directions; NULL for grids,
+     * whose scan order already is. */
+    uint64_t *trace_order;
     /* The model's parameters, kept for backends that generate rays themselves. */
     rc_spherical_desc spherical;
     rc_pinhole_desc pinhole;
@@ -44,6 +49,15 @@ size_t rc__sensor_bytes(uint32_t model, uint64_t rays);
 void rc__sensor_fill_spherical(const rc_spherical_desc *desc, float *dirs);
 void rc__sensor_fill_pinhole(const rc_pinhole_desc *desc, float *dirs);
 void rc__sensor_fill_cylindrical(const rc_cylindrical_desc *desc, float *dirs);
+
+/* Sorts the rays of an O1Dn/OnDn sensor into s->trace_order (ray_order.c). */
+void rc__sensor_order_rays(rc_sensor *s);
+
+/* Ray index at position i of the order the CPU backends trace a scan in. */
+static inline uint32_t rc__sensor_traced_ray(const rc_sensor *s, uint32_t i)
+{
+    return s->trace_order ? (uint32_t)s->trace_order[i] : i;
+}
 
 /* Livox-style rosette directions (non-repetitive, two counter-rotating prisms). */
 void rc__sensor_fill_rosette(float fov_rad, uint32_t count, float *dirs);
