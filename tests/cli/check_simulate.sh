@@ -253,7 +253,7 @@ EOF
     run 1 "beam_altitude_angles" "$RC" simulate --map sphere.ply --pose 0,0,0 -o p.pcd --sensor ouster:no_beams.json
     echo '[1, 2]' >array.json
     run 1 "not a JSON object" "$RC" simulate --map sphere.ply --pose 0,0,0 -o q.pcd --sensor ouster:array.json
-    run 1 "cannot read it" "$RC" bench --triangles 1k --pose-count 1 --sensor ouster:missing.json
+    run 1 "missing.json: No such file" "$RC" bench --triangles 1k --pose-count 1 --sensor ouster:missing.json
     [ ! -e p.pcd ] && [ ! -e q.pcd ] || fail "a run on bad Ouster metadata wrote a cloud"
 else
     grep -q "without cJSON" err.txt || { cat err.txt >&2; fail "simulate --sensor ouster:FILE"; }

@@ -60,25 +60,6 @@ static double *numbers(const cJSON *a, uint32_t *n)
     return v;
 }
 
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    char *text = NULL;
-    long size;
-    if (!f) return NULL;
-    if (fseek(f, 0, SEEK_END) == 0 && (size = ftell(f)) >= 0 && size < (1L << 26) && fseek(f, 0, SEEK_SET) == 0 &&
-        (text = (char *)malloc((size_t)size + 1u)) != NULL) {
-        if (fread(text, 1, (size_t)size, f) != (size_t)size) {
-            free(text);
-            text = NULL;
-        } else {
-            text[size] = 0;
-        }
-    }
-    fclose(f);
-    return text;
-}
-
 /* The columns of a frame: lidar_data_format.columns_per_frame, else the
  * "1024" of lidar_mode "1024x10". 0 when neither is there. */
 static uint32_t columns_of(const cJSON *root)
@@ -96,7 +77,8 @@ static uint32_t columns_of(const cJSON *root)
 
 int rcp_ouster_load(const char *path, rcp_rays *out)
 {
-    char *text = read_text(path);
+    unsigned char *text = NULL;
+    size_t size = 0;
     cJSON *root;
     rc_ouster_desc d = rc_ouster_desc_default();
     rc_rays_desc rd;
@@ -106,8 +88,8 @@ int rcp_ouster_load(const char *path, rcp_rays *out)
     const char *problem = NULL;
     rc_status st = RC_OK;
     memset(out, 0, sizeof *out);
-    if (!text) return rcu_fail("%s: cannot read it", path);
-    root = cJSON_Parse(text);
+    if (rcu_read_file(path, &text, &size) != 0) return -1; /* its message names the file */
+    root = cJSON_Parse((const char *)text);
     free(text);
     if (!cJSON_IsObject(root)) {
         cJSON_Delete(root);
@@ -143,7 +125,7 @@ int rcp_ouster_load(const char *path, rcp_rays *out)
         out->origins = (float *)malloc(sizeof(float) * 3u * n);
         out->dirs = (float *)malloc(sizeof(float) * 3u * n);
         if (!out->origins || !out->dirs) problem = "out of memory for its rays";
-        else if ((st = rc_ouster_rays(&d, &rd, out->origins, out->dirs, &out->beam_offset_m)) != RC_OK)
+        else if ((st = rc_ouster_rays(&d, &rd, out->origins, out->dirs, NULL)) != RC_OK)
             problem = "rc_ouster_rays refused its values (a transform that is not rigid, a non-finite number, "
                       "or more than 2^24 rays)";
     }

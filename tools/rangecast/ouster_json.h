@@ -14,7 +14,6 @@ typedef struct rcp_rays {
     float *origins, *dirs;      /* 3 floats a ray (malloc'd) */
     uint32_t count, width, height;
     float range_min, range_max;
-    double beam_offset_m;       /* what the sensor adds to a range from the beam origin */
 } rcp_rays;
 
 /* The prefix that names an Ouster metadata file in --sensor. */
