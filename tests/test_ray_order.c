@@ -7,32 +7,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "poses.h"
 #include "rc_test.h"
 #include "sensor/sensor.h"
 
 #define RAYS 3000u
 
-static uint64_t rng = 0x2545F4914F6CDD1Dull;
-
-static float next_unit(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (float)(rng >> 40) / 16777216.0f * 2.0f - 1.0f;
-}
-
-/* Random rays: origins in a 2 m cube, directions anywhere. */
-static void random_rays(float *org, float *dir)
-{
-    uint32_t i;
-    for (i = 0; i < 3u * RAYS; ++i) {
-        org[i] = 2.0f * next_unit();
-        dir[i] = next_unit();
-    }
-    for (i = 0; i < RAYS; ++i)
-        if (fabsf(dir[3 * i]) + fabsf(dir[3 * i + 1]) + fabsf(dir[3 * i + 2]) < 1e-3f) dir[3 * i] = 1.0f;
-}
+/* Random rays (rcutil's, as bench --sensor random-ondn makes them): origins
+ * in a 2 m ball, directions anywhere. */
+static void random_rays(float *org, float *dir) { rcu_rays_random(RAYS, 2.0f, 11u, org, dir); }
 
 static rc_sensor *ondn(rc_context *ctx, const float *org, const float *dir)
 {
