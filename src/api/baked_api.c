@@ -90,8 +90,7 @@ rc_status rc_baked_get_mesh(const void *blob, size_t bytes, uint32_t geom_id, rc
 {
     const unsigned char *b = (const unsigned char *)blob;
     rc_scene_desc d;
-    const unsigned char *rec;
-    uint64_t header, off_v, off_i, v, t;
+    rc__baked_geom r;
     if (blob == NULL || bytes == 0 || (uintptr_t)blob % 16u != 0) return RC_ERR_INVALID_ARGUMENT;
     if (mesh == NULL && geometry_count == NULL) return RC_ERR_INVALID_ARGUMENT;
     if (mesh != NULL && mesh->struct_size != sizeof *mesh) return RC_ERR_STRUCT_SIZE;
@@ -99,21 +98,13 @@ rc_status rc_baked_get_mesh(const void *blob, size_t bytes, uint32_t geom_id, rc
     if (geometry_count) *geometry_count = d.max_geometries;
     if (mesh == NULL) return RC_OK;
     if (geom_id >= d.max_geometries) return RC_ERR_OUT_OF_RANGE;
-    header = rc__bk_header_bytes(d.max_geometries);
-    rec = b + RC__BAKED_HEADER + (size_t)geom_id * RC__BAKED_RECORD;
-    v = rc__bk_u32(rec, RC__BR_VERTICES);
-    t = rc__bk_u32(rec, RC__BR_TRIANGLES);
-    off_v = rc__bk_u64(rec, RC__BR_OFF_VERTICES);
-    off_i = rc__bk_u64(rec, RC__BR_OFF_INDICES);
-    if (v == 0 || t == 0 || off_v % RC__BAKED_ALIGN || off_i % RC__BAKED_ALIGN || off_v < header ||
-        off_i < header || off_v > bytes || off_i > bytes || v * 16u > bytes - off_v || t * 12u > bytes - off_i)
-        return RC_ERR_CORRUPT_DATA;
+    RC_TRY(rc__baked_read_geometry(NULL, b, bytes, geom_id, &r));
     *mesh = rc_mesh_desc_default();
     mesh->flags = RC_MESH_REFERENCE;
-    mesh->vertices = (const float *)(const void *)(b + off_v);
-    mesh->vertex_count = v;
+    mesh->vertices = (const float *)(const void *)(b + r.off_vertices);
+    mesh->vertex_count = r.vertices;
     mesh->vertex_stride = RC__BAKED_VERTEX_FLOATS * (uint32_t)sizeof(float);
-    mesh->indices = (const uint32_t *)(const void *)(b + off_i);
-    mesh->triangle_count = t;
+    mesh->indices = (const uint32_t *)(const void *)(b + r.off_indices);
+    mesh->triangle_count = r.triangles;
     return RC_OK;
 }

@@ -31,6 +31,7 @@
 #define RC_SCENE_BAKED_FORMAT_H
 
 #include "core/crc32c.h"
+#include "rangecast/rangecast.h"
 
 #include <stddef.h>
 #include <stdint.h>
@@ -90,6 +91,19 @@ static inline uint64_t rc__bk_header_bytes(uint32_t geometries)
 {
     return rc__bk_align((uint64_t)RC__BAKED_HEADER + (uint64_t)RC__BAKED_RECORD * geometries);
 }
+
+/* A geometry record, read. */
+typedef struct rc__baked_geom {
+    uint32_t vertices, triangles, nodes;
+    uint64_t off_vertices, off_indices, off_refs, off_leaf_tris, off_nodes;
+} rc__baked_geom;
+
+/* Reads record g of a blob whose header passed rc__baked_scene_desc and
+ * checks its counts, reserved fields and that every section lies inside the
+ * blob on its boundary (not the sections' contents): RC_ERR_CORRUPT_DATA with
+ * the message to ctx (may be NULL) otherwise. */
+rc_status rc__baked_read_geometry(rc_context *ctx, const unsigned char *blob, uint64_t total, uint32_t g,
+                                  rc__baked_geom *r);
 
 /* The blob's checksum: CRC-32C of all of it with the checksum field as zero. */
 uint32_t rc__baked_checksum(const unsigned char *blob, size_t bytes);

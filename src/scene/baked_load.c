@@ -19,11 +19,6 @@
 
 #define CORRUPT RC_ERR_CORRUPT_DATA
 
-typedef struct baked_geom {
-    uint32_t vertices, triangles, nodes;
-    uint64_t off_vertices, off_indices, off_refs, off_leaf_tris, off_nodes;
-} baked_geom;
-
 static int all_zero(const unsigned char *p, size_t n)
 {
     size_t i;
@@ -94,7 +89,8 @@ static int section_ok(uint64_t off, uint64_t size, uint64_t header, uint64_t tot
     return off % RC__BAKED_ALIGN == 0 && off >= header && off <= total && size <= total - off;
 }
 
-static rc_status read_record(rc_context *ctx, const unsigned char *blob, uint64_t total, uint32_t g, baked_geom *r)
+rc_status rc__baked_read_geometry(rc_context *ctx, const unsigned char *blob, uint64_t total, uint32_t g,
+                                  rc__baked_geom *r)
 {
     const unsigned char *rec = blob + RC__BAKED_HEADER + (size_t)g * RC__BAKED_RECORD;
     const uint64_t header = rc__bk_header_bytes(rc__bk_u32(blob, RC__BK_GEOMETRIES));
@@ -134,7 +130,7 @@ static int box_holds(const rc__wnode *n, uint32_t c, const float p[3])
 
 /* Child slot c of node i (inner child: a node after i, whose used slots'
  * boxes lie inside slot c's box; leaf: triangles whose vertices do). */
-static rc_status check_slot(rc_context *ctx, uint32_t g, const baked_geom *r, const rc__wnode *nodes, uint32_t i,
+static rc_status check_slot(rc_context *ctx, uint32_t g, const rc__baked_geom *r, const rc__wnode *nodes, uint32_t i,
                             uint32_t c, const float *vertices, const uint32_t *leaf_tris)
 {
     const rc__wnode *n = &nodes[i];
@@ -181,7 +177,7 @@ static rc_status check_slot(rc_context *ctx, uint32_t g, const baked_geom *r, co
     return RC_OK;
 }
 
-static rc_status check_geometry(rc_context *ctx, const unsigned char *blob, uint32_t g, const baked_geom *r)
+static rc_status check_geometry(rc_context *ctx, const unsigned char *blob, uint32_t g, const rc__baked_geom *r)
 {
     const float *v = (const float *)(const void *)(blob + r->off_vertices);
     const uint32_t *idx = (const uint32_t *)(const void *)(blob + r->off_indices);
@@ -224,8 +220,8 @@ rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_
     }
     geoms = d.max_geometries;
     for (g = 0; g < geoms; ++g) {
-        baked_geom r;
-        RC_TRY(read_record(ctx, blob, bytes, g, &r));
+        rc__baked_geom r;
+        RC_TRY(rc__baked_read_geometry(ctx, blob, bytes, g, &r));
         RC_TRY(check_geometry(ctx, blob, g, &r));
     }
     s = rc__scene_new(ctx, &d);
@@ -233,8 +229,8 @@ rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_
     for (g = 0; g < geoms; ++g) {
         rc__geometry *geo = &s->geoms[g];
         rc__mesh *m = &geo->mesh;
-        baked_geom r;
-        read_record(ctx, blob, bytes, g, &r);
+        rc__baked_geom r;
+        rc__baked_read_geometry(ctx, blob, bytes, g, &r);
         geo->flags = RC_MESH_REFERENCE;
         m->vertices = (const float *)(const void *)(blob + r.off_vertices);
         m->indices = (const uint32_t *)(const void *)(blob + r.off_indices);
