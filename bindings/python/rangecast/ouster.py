@@ -33,6 +33,7 @@ range limits: pass range_min and range_max, or take the OS1 defaults here.
 
 import ctypes
 import json
+import math
 
 import numpy as np
 
@@ -104,7 +105,7 @@ def read_metadata(source):
 
 
 def _c_rays(meta):
-    """rc_ouster_rays on meta: (origins, directions) as (N, 3) float32, and the beam offset."""
+    """rc_ouster_rays on meta: (origins, directions) as (N, 3) float32."""
     h, w = meta["altitudes"].size, meta["columns"]
     alt = np.ascontiguousarray(meta["altitudes"], dtype=np.float64)
     azi = np.ascontiguousarray(meta["azimuths"], dtype=np.float64)
@@ -116,13 +117,12 @@ def _c_rays(meta):
     d.lidar_to_sensor[:] = [float(x) for x in meta["lidar_to_sensor"].reshape(16)]
     origins = np.empty((h * w, 3), np.float32)
     directions = np.empty((h * w, 3), np.float32)
-    offset = ctypes.c_double()
     status = F.lib.rc_ouster_rays(ctypes.byref(d), None, origins.ctypes.data_as(ctypes.POINTER(ctypes.c_float)),
-                                  directions.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), ctypes.byref(offset))
+                                  directions.ctypes.data_as(ctypes.POINTER(ctypes.c_float)), None)
     if status != 0:
         raise Error(status, "rc_ouster_rays refused the metadata (%d beams x %d columns): a transform that is not "
                     "rigid, or more than 2^24 rays" % (h, w))
-    return origins, directions, offset.value
+    return origins, directions
 
 
 def _meta(meta):
@@ -133,8 +133,7 @@ def rays(meta):
     """(origins, directions): two (beams * columns, 3) float32 arrays in the
     sensor frame, metres and unit vectors, row = beam, column = measurement
     id (rc_ouster_rays). meta: read_metadata's dict, or what it reads."""
-    origins, directions, _ = _c_rays(_meta(meta))
-    return origins, directions
+    return _c_rays(_meta(meta))
 
 
 def sensor(ctx, meta, range_min=0.3, range_max=120.0, mounting=None):
@@ -144,7 +143,7 @@ def sensor(ctx, meta, range_min=0.3, range_max=120.0, mounting=None):
     range_min and range_max bound the distance from each beam origin; the
     defaults are an OS1's."""
     meta = _meta(meta)
-    origins, directions, _ = _c_rays(meta)
+    origins, directions = _c_rays(meta)
     return ctx.rays_sensor(directions, range_min, range_max, origins=origins,
                            shape=(meta["altitudes"].size, meta["columns"]), mounting=mounting)
 
@@ -152,7 +151,8 @@ def sensor(ctx, meta, range_min=0.3, range_max=120.0, mounting=None):
 def sensor_ranges(ranges, meta):
     """Ranges as the sensor reports them: the simulated distance from each beam
     origin plus the beam offset (no return stays +inf, too near stays -inf)."""
-    _, _, offset = _c_rays(_meta(meta))
+    b = _meta(meta)["beam_to_lidar"]
+    offset = math.hypot(b[0, 3], b[2, 3]) / 1000.0  # rc_ouster_rays' beam_offset_m, without making every ray
     r = np.array(ranges, dtype=np.float64, copy=True)
     finite = np.isfinite(r)
     r[finite] += offset
