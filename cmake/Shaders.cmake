@@ -6,6 +6,8 @@
 # without shaderFloat64 cannot even load a module that declares it) and with
 # 1 or 4 storage-buffer bindings per large array (4 lets one array exceed
 # maxStorageBufferRange, but needs 18 storage buffers per stage).
+# raycast_rq.comp (the same body with GL_EXT_ray_query, for
+# RC_CONTEXT_VULKAN_RAY_QUERY) is compiled the same four ways for Vulkan 1.2.
 #
 # rc_add_shader_dependencies(target) makes a target wait for the headers.
 
@@ -15,16 +17,22 @@ file(MAKE_DIRECTORY ${RC_GENERATED_DIR})
 file(GLOB RC_KERNEL_INCLUDES CONFIGURE_DEPENDS ${RC_KERNEL_DIR}/*.glsl)
 set(RC_SHADER_HEADERS "")
 
-# rc_compile_shader(<source .comp> <array name> [defines...])
+# rc_compile_shader(<source .comp> <array name> [defines...]); a define
+# TARGET=vulkan1.2 picks the target environment (default vulkan1.1).
 function(rc_compile_shader source name)
   set(out ${RC_GENERATED_DIR}/${name}.h)
   set(defs "")
+  set(target vulkan1.1)
   foreach(d ${ARGN})
-    list(APPEND defs -D${d})
+    if(d MATCHES "^TARGET=(.*)$")
+      set(target ${CMAKE_MATCH_1})
+    else()
+      list(APPEND defs -D${d})
+    endif()
   endforeach()
   add_custom_command(
     OUTPUT ${out}
-    COMMAND ${GLSLANG_VALIDATOR} -V --target-env vulkan1.1 ${defs} --vn ${name} -o ${out}
+    COMMAND ${GLSLANG_VALIDATOR} -V --target-env ${target} ${defs} --vn ${name} -o ${out}
             ${RC_KERNEL_DIR}/${source}
     DEPENDS ${RC_KERNEL_DIR}/${source} ${RC_KERNEL_INCLUDES}
     WORKING_DIRECTORY ${RC_KERNEL_DIR}
@@ -37,6 +45,10 @@ rc_compile_shader(raycast.comp rc__spv_raycast_f64_c4 RC_FP64=1 RC_CHUNKS=4)
 rc_compile_shader(raycast.comp rc__spv_raycast_f32_c4 RC_FP64=0 RC_CHUNKS=4)
 rc_compile_shader(raycast.comp rc__spv_raycast_f64_c1 RC_FP64=1 RC_CHUNKS=1)
 rc_compile_shader(raycast.comp rc__spv_raycast_f32_c1 RC_FP64=0 RC_CHUNKS=1)
+rc_compile_shader(raycast_rq.comp rc__spv_raycast_rq_f64_c4 RC_FP64=1 RC_CHUNKS=4 TARGET=vulkan1.2)
+rc_compile_shader(raycast_rq.comp rc__spv_raycast_rq_f32_c4 RC_FP64=0 RC_CHUNKS=4 TARGET=vulkan1.2)
+rc_compile_shader(raycast_rq.comp rc__spv_raycast_rq_f64_c1 RC_FP64=1 RC_CHUNKS=1 TARGET=vulkan1.2)
+rc_compile_shader(raycast_rq.comp rc__spv_raycast_rq_f32_c1 RC_FP64=0 RC_CHUNKS=1 TARGET=vulkan1.2)
 rc_compile_shader(layout_check.comp rc__spv_layout_check)
 
 add_custom_target(rangecast_shaders DEPENDS ${RC_SHADER_HEADERS})

@@ -289,7 +289,13 @@ static void test_create_messages_name_the_field(void **state)
     expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->thread_count is 257");
     d = rc_context_desc_default();
     d.flags = 4;
-    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->flags is 4");
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "desc->flags is 0x4");
+    d = rc_context_desc_default();
+    d.flags = RC_CONTEXT_VULKAN_RAY_QUERY;
+    d.backend = RC_BACKEND_BVH;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "needs desc->backend RC_BACKEND_VULKAN (it is bvh)");
+    d.backend = RC_BACKEND_AUTO;
+    expect_create(&d, RC_ERR_INVALID_ARGUMENT, "needs desc->backend RC_BACKEND_VULKAN");
     d = rc_context_desc_default();
     d.memory = aligned + 4;
     d.memory_size = 4000;

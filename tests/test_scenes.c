@@ -392,6 +392,12 @@ static void test_watertight(void **state)
     const float lo[3] = {-1.0f, -2.0f, -3.0f}, hi[3] = {4.0f, 5.0f, 6.0f};
     const float c0[3] = {0, 0, 0}, c1[3] = {0.3f, -0.7f, 0.1f}, c2[3] = {1.0f, 1.0f, 1.0f};
     NEED_BACKEND(b);
+    if (b == RC_BACKEND_VULKAN && rct_env_on("RANGECAST_VULKAN_RAY_QUERY")) {
+        /* the driver's triangle test decides; test_vulkan_ray_query counts
+         * its escapes against the compute traversal's none */
+        print_message("SKIP: the ray query traversal is as watertight as the driver (RANGECAST_VULKAN_RAY_QUERY)\n");
+        skip();
+    }
     assert_int_equal(rcu_mesh_uv_sphere(5.0f, 40, 20, &m), 0);
     check_closed(b, &m, c0);
     check_closed(b, &m, c1);

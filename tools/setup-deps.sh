@@ -36,6 +36,14 @@ case "$profile" in
   *) echo "usage: $0 demo|test|cross|all|cross-aarch64|cross-armhf|cross-riscv64|multiarch-arm64" >&2; exit 2 ;;
 esac
 
+# The Vulkan ray query tests' driver (tools/fetch-lavapipe-rq.sh): unpacked
+# under the user's cache, not installed; without it those tests are left out.
+case "$profile" in
+  test|all)
+    sh "$(dirname "$0")/fetch-lavapipe-rq.sh" ||
+      echo "setup-deps: no lavapipe with ray query; its tests will be left out" >&2 ;;
+esac
+
 missing=""
 for p in $want; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then

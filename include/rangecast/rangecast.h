@@ -167,7 +167,7 @@ typedef struct rc_context_desc {
     uint32_t struct_size;   /* sizeof(rc_context_desc) */
     uint32_t backend;       /* RC_BACKEND_*; 0 = AUTO */
     uint32_t thread_count;  /* 0 = number of online CPUs; 1 = run on the caller's thread */
-    uint32_t flags;         /* none yet: must be 0 */
+    uint32_t flags;         /* RC_CONTEXT_* below; 0 = defaults */
     /* The arena. memory != NULL: the caller's block of memory_size bytes,
      * aligned to 16 (RC_ARENA_ALIGNMENT); the library never calls malloc.
      * memory == NULL: the library mallocs memory_size bytes once, here
@@ -196,6 +196,19 @@ typedef struct rc_context_desc {
     uint32_t backend_budget_mib;
     uint32_t reserved[7];   /* must be 0 */
 } rc_context_desc;
+
+/* rc_context_desc.flags. RC_CONTEXT_VULKAN_RAY_QUERY (backend
+ * RC_BACKEND_VULKAN only, else RC_ERR_INVALID_ARGUMENT): find each ray's
+ * nearest hit with VK_KHR_ray_query in the driver's acceleration structures
+ * (built at commit from the same meshes) instead of the compute kernel's own
+ * BVH walk, which stays the default: no device measured so far ran it faster
+ * (docs/benchmarks.md, "Vulkan"), and GPUs with ray tracing hardware are the
+ * ones to try it on. Rays, the float64 range refinement and the attributes are
+ * the compute kernel's; ids may differ where two triangles tie, and a ray
+ * through an edge is as watertight as the driver's test (docs/stability.md).
+ * A device without Vulkan 1.2, VK_KHR_acceleration_structure and
+ * VK_KHR_ray_query: RC_ERR_UNSUPPORTED naming what is missing. */
+#define RC_CONTEXT_VULKAN_RAY_QUERY 0x1u
 
 #define RC_ARENA_ALIGNMENT 16u
 #define RC_DEFAULT_ARENA_SIZE ((size_t)256 << 20)

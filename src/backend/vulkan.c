@@ -66,6 +66,7 @@ static rc_status vk_init(rc_context *ctx, const rc_context_desc *desc)
                  (unsigned long long)rc__arena_cost(sizeof *st));
     st->ctx = ctx;
     st->want_device = desc->device;
+    st->want_ray_query = (desc->flags & RC_CONTEXT_VULKAN_RAY_QUERY) != 0;
     st->budget_bytes = (uint64_t)desc->backend_budget_mib << 20;
     ctx->backend_data = st;
     s = rc__vk_device_create(st);
@@ -79,11 +80,12 @@ static rc_status vk_init(rc_context *ctx, const rc_context_desc *desc)
     }
     rc__log(ctx, RC_LOG_INFO,
             "vulkan: %s (Vulkan %u.%u), %s kernel, %u binding(s) per large array of at most %llu bytes, "
-            "workgroup %u, subgroup %u, device memory %s",
+            "workgroup %u, subgroup %u, device memory %s, %s",
             st->device_name, (unsigned)VK_API_VERSION_MAJOR(st->props.apiVersion),
             (unsigned)VK_API_VERSION_MINOR(st->props.apiVersion), st->fp64 ? "float64" : "float-only",
             (unsigned)st->chunks, (unsigned long long)st->max_binding, (unsigned)st->wg_size,
-            (unsigned)st->subgroup_size, st->device_mappable ? "mapped" : "staged");
+            (unsigned)st->subgroup_size, st->device_mappable ? "mapped" : "staged",
+            st->ray_query ? "ray query traversal" : "compute traversal");
     return RC_OK;
 }
 

@@ -14,7 +14,9 @@
  *   RANGECAST_VULKAN_STAGING      1: upload through staging copies even where
  *                                 device memory is host-visible
  *   RANGECAST_VULKAN_WG           workgroup size (power of two, 8..1024)
- *   RANGECAST_VULKAN_SLOT_MB      MiB of results one dispatch may write (default 8) */
+ *   RANGECAST_VULKAN_SLOT_MB      MiB of results one dispatch may write (default 8)
+ *   RANGECAST_VULKAN_RAY_QUERY    1: as RC_CONTEXT_VULKAN_RAY_QUERY (runs a test
+ *                                 suite on the ray query traversal unchanged) */
 #include "backend/vulkan_internal.h"
 
 #include <stdio.h>
@@ -145,6 +147,13 @@ static void *VKAPI_PTR vk_host_realloc(void *user, void *old, size_t size, size_
     vk_host_free(user, old);
     return p;
 }
+
+void *rc__vk_host_alloc(rc__vk_state *st, size_t size)
+{
+    return vk_host_alloc(st, size, 16, VK_SYSTEM_ALLOCATION_SCOPE_OBJECT);
+}
+
+void rc__vk_host_free(rc__vk_state *st, void *p) { vk_host_free(st, p); }
 
 /* ---- instance and device ------------------------------------------------------ */
 
@@ -329,9 +338,25 @@ static int type_for(const rc__vk_state *st, uint32_t kind, uint32_t bits)
 
 rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kind, const char *what, rc__vk_buffer *out)
 {
+    return rc__vk_buffer_create_usage(st, size, kind, 0, what, out);
+}
+
+VkDeviceAddress rc__vk_buffer_address(const rc__vk_state *st, const rc__vk_buffer *b)
+{
+    VkBufferDeviceAddressInfo ai;
+    memset(&ai, 0, sizeof ai);
+    ai.sType = VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO;
+    ai.buffer = b->buf;
+    return st->get_address(st->device, &ai);
+}
+
+rc_status rc__vk_buffer_create_usage(rc__vk_state *st, VkDeviceSize size, uint32_t kind, VkBufferUsageFlags usage,
+                                     const char *what, rc__vk_buffer *out)
+{
     VkBufferCreateInfo bi;
     VkMemoryRequirements req;
     VkMemoryAllocateInfo ai;
+    VkMemoryAllocateFlagsInfo af;
     VkMemoryPropertyFlags flags;
     VkResult r;
     int type;
@@ -348,7 +373,8 @@ rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kin
     memset(&bi, 0, sizeof bi);
     bi.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     bi.size = size;
-    bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+               usage;
     bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     r = vkCreateBuffer(st->device, &bi, RC__VK_OBJ_ALLOC, &out->buf);
     if (r != VK_SUCCESS) {
@@ -373,6 +399,12 @@ rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kin
     ai.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO;
     ai.allocationSize = req.size;
     ai.memoryTypeIndex = (uint32_t)type;
+    if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) {
+        memset(&af, 0, sizeof af);
+        af.sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO;
+        af.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
+        ai.pNext = &af;
+    }
     r = vkAllocateMemory(st->device, &ai, RC__VK_OBJ_ALLOC, &out->mem);
     if (r != VK_SUCCESS) {
         out->mem = VK_NULL_HANDLE;
@@ -601,6 +633,90 @@ static rc_status probe_memory(rc__vk_state *st)
     return RC_OK;
 }
 
+/* ---- ray query (RC_CONTEXT_VULKAN_RAY_QUERY) ------------------------------- */
+
+static const char *const ray_query_extensions[] = {"VK_KHR_acceleration_structure", "VK_KHR_ray_query",
+                                                   "VK_KHR_deferred_host_operations"};
+
+typedef struct rq_features {
+    VkPhysicalDeviceBufferDeviceAddressFeatures bda;
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel;
+    VkPhysicalDeviceRayQueryFeaturesKHR query;
+} rq_features;
+
+/* The chosen device has what the ray query traversal needs: Vulkan 1.2, the
+ * extensions and their features. RC_ERR_UNSUPPORTED naming what is missing. */
+static rc_status ray_query_support(rc__vk_state *st)
+{
+    VkExtensionProperties ext[512];
+    uint32_t n = 512, i, k;
+    VkPhysicalDeviceFeatures2 f2;
+    VkPhysicalDeviceAccelerationStructurePropertiesKHR ap;
+    VkPhysicalDeviceProperties2 p2;
+    rq_features rq;
+    VkResult r;
+    RC_RETURN_IF(st->ctx, st->props.apiVersion < VK_API_VERSION_1_2, RC_ERR_UNSUPPORTED,
+                 "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs Vulkan 1.2; %s has %u.%u", st->device_name,
+                 (unsigned)VK_VERSION_MAJOR(st->props.apiVersion), (unsigned)VK_VERSION_MINOR(st->props.apiVersion));
+    r = vkEnumerateDeviceExtensionProperties(st->phys, NULL, &n, ext);
+    if (r != VK_SUCCESS && r != VK_INCOMPLETE) return rc__vk_fail(st, r, "vkEnumerateDeviceExtensionProperties");
+    for (k = 0; k < sizeof ray_query_extensions / sizeof ray_query_extensions[0]; ++k) {
+        int found = 0;
+        for (i = 0; i < n && !found; ++i) found = strcmp(ext[i].extensionName, ray_query_extensions[k]) == 0;
+        RC_RETURN_IF(st->ctx, !found, RC_ERR_UNSUPPORTED,
+                     "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs %s, which %s does not offer (Mesa's lavapipe has "
+                     "it from 23.1 on)",
+                     ray_query_extensions[k], st->device_name);
+    }
+    memset(&rq, 0, sizeof rq);
+    rq.bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+    rq.bda.pNext = &rq.accel;
+    rq.accel.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+    rq.accel.pNext = &rq.query;
+    rq.query.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+    memset(&f2, 0, sizeof f2);
+    f2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2;
+    f2.pNext = &rq.bda;
+    vkGetPhysicalDeviceFeatures2(st->phys, &f2);
+    RC_RETURN_IF(st->ctx, !rq.bda.bufferDeviceAddress || !rq.accel.accelerationStructure || !rq.query.rayQuery,
+                 RC_ERR_UNSUPPORTED,
+                 "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY: %s lacks a feature it needs (bufferDeviceAddress %u, "
+                 "accelerationStructure %u, rayQuery %u)",
+                 st->device_name, (unsigned)rq.bda.bufferDeviceAddress, (unsigned)rq.accel.accelerationStructure,
+                 (unsigned)rq.query.rayQuery);
+    memset(&ap, 0, sizeof ap);
+    ap.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_PROPERTIES_KHR;
+    memset(&p2, 0, sizeof p2);
+    p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
+    p2.pNext = &ap;
+    vkGetPhysicalDeviceProperties2(st->phys, &p2);
+    st->scratch_align = ap.minAccelerationStructureScratchOffsetAlignment ? ap.minAccelerationStructureScratchOffsetAlignment : 1u;
+    return RC_OK;
+}
+
+/* The extension's entry points, through the device (no link-time dependency
+ * on a Vulkan 1.2 loader). */
+static rc_status ray_query_functions(rc__vk_state *st)
+{
+    st->get_address = (PFN_vkGetBufferDeviceAddress)vkGetDeviceProcAddr(st->device, "vkGetBufferDeviceAddress");
+    st->create_as =
+        (PFN_vkCreateAccelerationStructureKHR)vkGetDeviceProcAddr(st->device, "vkCreateAccelerationStructureKHR");
+    st->destroy_as =
+        (PFN_vkDestroyAccelerationStructureKHR)vkGetDeviceProcAddr(st->device, "vkDestroyAccelerationStructureKHR");
+    st->as_sizes = (PFN_vkGetAccelerationStructureBuildSizesKHR)vkGetDeviceProcAddr(
+        st->device, "vkGetAccelerationStructureBuildSizesKHR");
+    st->build_as =
+        (PFN_vkCmdBuildAccelerationStructuresKHR)vkGetDeviceProcAddr(st->device, "vkCmdBuildAccelerationStructuresKHR");
+    st->as_address = (PFN_vkGetAccelerationStructureDeviceAddressKHR)vkGetDeviceProcAddr(
+        st->device, "vkGetAccelerationStructureDeviceAddressKHR");
+    RC_RETURN_IF(st->ctx, !st->get_address || !st->create_as || !st->destroy_as || !st->as_sizes || !st->build_as ||
+                              !st->as_address,
+                 RC_ERR_BACKEND, "vulkan: %s enabled VK_KHR_acceleration_structure but lacks one of its functions",
+                 st->device_name);
+    st->ray_query = 1;
+    return RC_OK;
+}
+
 rc_status rc__vk_device_create(rc__vk_state *st)
 {
     VkApplicationInfo app;
@@ -608,12 +724,14 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     VkDeviceQueueCreateInfo qi;
     VkDeviceCreateInfo dci;
     VkPhysicalDeviceFeatures enable;
+    rq_features rq;
     VkCommandPoolCreateInfo pci;
     VkCommandBufferAllocateInfo cai;
     VkFenceCreateInfo fi;
     const float priority = 1.0f;
     uint32_t i;
 
+    if (env_flag("RANGECAST_VULKAN_RAY_QUERY")) st->want_ray_query = 1;
     st->alloc.pUserData = st;
     st->alloc.pfnAllocation = vk_host_alloc;
     st->alloc.pfnReallocation = vk_host_realloc;
@@ -625,7 +743,8 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     app.pApplicationName = "rangecast";
     app.pEngineName = "rangecast";
     app.engineVersion = RC_VERSION_NUMBER;
-    app.apiVersion = VK_API_VERSION_1_1;
+    /* 1.2 for buffer device addresses, which ray query's structures need */
+    app.apiVersion = st->want_ray_query ? VK_API_VERSION_1_2 : VK_API_VERSION_1_1;
     memset(&ici, 0, sizeof ici);
     ici.sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO;
     ici.pApplicationInfo = &app;
@@ -641,6 +760,7 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     }
     RC_TRY(pick_device(st));
     RC_TRY(device_limits(st));
+    if (st->want_ray_query) RC_TRY(ray_query_support(st));
 
     memset(&qi, 0, sizeof qi);
     qi.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -654,6 +774,20 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qi;
     dci.pEnabledFeatures = &enable;
+    if (st->want_ray_query) {
+        memset(&rq, 0, sizeof rq);
+        rq.bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
+        rq.bda.bufferDeviceAddress = VK_TRUE;
+        rq.bda.pNext = &rq.accel;
+        rq.accel.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR;
+        rq.accel.accelerationStructure = VK_TRUE;
+        rq.accel.pNext = &rq.query;
+        rq.query.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
+        rq.query.rayQuery = VK_TRUE;
+        dci.pNext = &rq.bda;
+        dci.enabledExtensionCount = (uint32_t)(sizeof ray_query_extensions / sizeof ray_query_extensions[0]);
+        dci.ppEnabledExtensionNames = ray_query_extensions;
+    }
     {
         VkResult r = vkCreateDevice(st->phys, &dci, &st->alloc, &st->device);
         if (r != VK_SUCCESS) {
@@ -662,6 +796,7 @@ rc_status rc__vk_device_create(rc__vk_state *st)
         }
     }
     vkGetDeviceQueue(st->device, st->queue_family, 0, &st->queue);
+    if (st->want_ray_query) RC_TRY(ray_query_functions(st));
     RC_TRY(probe_memory(st));
 
     memset(&pci, 0, sizeof pci);

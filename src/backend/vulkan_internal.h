@@ -58,6 +58,13 @@ typedef struct rc__vk_pack_dst {
     rc__vk_span nodes, refs, tris, verts, geoms, insts;
 } rc__vk_pack_dst;
 
+/* A driver acceleration structure (ray query traversal) and its storage. */
+typedef struct rc__vk_accel {
+    VkAccelerationStructureKHR as;
+    VkDeviceAddress address;
+    rc__vk_buffer storage;
+} rc__vk_accel;
+
 typedef struct rc__vk_scene {
     rc__vk_buffer nodes[RC__VK_MAX_CHUNKS], tris[RC__VK_MAX_CHUNKS], verts[RC__VK_MAX_CHUNKS];
     rc__vk_buffer refs, geoms, insts;
@@ -67,6 +74,16 @@ typedef struct rc__vk_scene {
     uint32_t pack_first_geom;
     uint32_t fill_serial;
     rc__vk_pack_info info;
+    /* ray query traversal (vulkan_accel.c): the top level, and the bottom
+     * levels it instances: [0] the scene's own meshes (when it has any), then
+     * one per instanced source scene, in packing order; pack_blas tags a
+     * source with its index while another scene commits */
+    rc__vk_accel tlas;
+    rc__vk_accel *blas;        /* blas_count entries, from the driver's host allocator */
+    uint32_t blas_count;
+    uint32_t pack_blas;
+    uint32_t accel_serial;
+    uint32_t reserved0;
 } rc__vk_scene;
 
 typedef struct rc__vk_pipeline {
@@ -90,6 +107,8 @@ typedef struct rc__vk_sensor_slot {
 typedef struct rc__vk_state {
     rc_context *ctx;
     const char *want_device;  /* rc_context_desc.device, during init only */
+    uint32_t want_ray_query;  /* RC_CONTEXT_VULKAN_RAY_QUERY or RANGECAST_VULKAN_RAY_QUERY=1 */
+    uint32_t reserved1;
     VkAllocationCallbacks alloc;
     uint64_t host_bytes;     /* bytes the driver holds through our callbacks */
     uint64_t device_bytes;   /* bytes of VkDeviceMemory we hold, all kinds */
@@ -109,6 +128,14 @@ typedef struct rc__vk_state {
     uint64_t heap_size;      /* size of the heap device buffers come from */
     uint32_t subgroup_size;
     uint32_t fp64;           /* shaderFloat64 enabled: the RC_FP64 1 kernel */
+    uint32_t ray_query;      /* trace with VK_KHR_ray_query (RC_CONTEXT_VULKAN_RAY_QUERY) */
+    uint32_t scratch_align;  /* minAccelerationStructureScratchOffsetAlignment */
+    PFN_vkGetBufferDeviceAddress get_address;
+    PFN_vkCreateAccelerationStructureKHR create_as;
+    PFN_vkDestroyAccelerationStructureKHR destroy_as;
+    PFN_vkGetAccelerationStructureBuildSizesKHR as_sizes;
+    PFN_vkCmdBuildAccelerationStructuresKHR build_as;
+    PFN_vkGetAccelerationStructureDeviceAddressKHR as_address;
     uint32_t chunks;         /* most bindings per large array: 1 or 4 */
     uint32_t node_shift, tri_shift, vert_shift;
     uint32_t wg_size;        /* workgroup size */
@@ -167,6 +194,15 @@ void rc__vk_device_destroy(rc__vk_state *st);
  * RC_ERR_OUT_OF_MEMORY, with `what` in the message, when it cannot fit. */
 rc_status rc__vk_buffer_create(rc__vk_state *st, VkDeviceSize size, uint32_t kind, const char *what,
                                rc__vk_buffer *out);
+/* The same with more usage bits (acceleration structure storage or build
+ * input); VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT among them allocates the
+ * memory for device addresses. */
+rc_status rc__vk_buffer_create_usage(rc__vk_state *st, VkDeviceSize size, uint32_t kind, VkBufferUsageFlags usage,
+                                     const char *what, rc__vk_buffer *out);
+VkDeviceAddress rc__vk_buffer_address(const rc__vk_state *st, const rc__vk_buffer *b);
+/* Host memory through the driver's counting allocator (backend_bytes). */
+void *rc__vk_host_alloc(rc__vk_state *st, size_t size);
+void rc__vk_host_free(rc__vk_state *st, void *p);
 void rc__vk_buffer_destroy(rc__vk_state *st, rc__vk_buffer *b);
 /* Makes host writes visible / device writes visible to the host (non-coherent memory). */
 rc_status rc__vk_buffer_flush(rc__vk_state *st, const rc__vk_buffer *b);
@@ -186,7 +222,7 @@ void rc__vk_barrier(rc__vk_state *st, VkCommandBuffer cb, VkPipelineStageFlags s
 /* vulkan_shaders.c -------------------------------------------------------- */
 
 /* SPIR-V of raycast.comp for the variant, and of layout_check.comp. */
-const uint32_t *rc__vk_raycast_spirv(int fp64, uint32_t chunks, size_t *bytes);
+const uint32_t *rc__vk_raycast_spirv(int fp64, uint32_t chunks, int ray_query, size_t *bytes);
 const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
 
 /* vulkan_pack.c ----------------------------------------------------------- */
@@ -217,6 +253,13 @@ int rc__vk_packed_intersect(const rc__vk_packed *p, const rc__ray *ray, rc__hit 
 rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user);
 void rc__vk_scene_release(rc_scene *scene);
 size_t rc__vk_scene_commit_bytes(const rc_scene_desc *desc);
+
+/* vulkan_accel.c ----------------------------------------------------------- */
+
+/* Builds the scene's driver acceleration structures from its packed meshes
+ * (after rc__vk_pack_count with serial tagged the instance sources). */
+rc_status rc__vk_accel_build(rc_scene *scene, uint32_t serial);
+void rc__vk_accel_release(rc__vk_state *st, rc__vk_scene *sv);
 
 /* vulkan_sensor.c --------------------------------------------------------- */
 

@@ -76,7 +76,8 @@ RC__VK_ASSERT(offsetof(rc__vk_push, off) == 52, push_off);
 #define RC__VK_BIND_XFORMS 15u
 #define RC__VK_BIND_RAYS 16u
 #define RC__VK_BIND_OUT 17u
-#define RC__VK_BINDINGS 18u
+#define RC__VK_BINDINGS 18u   /* storage buffers */
+#define RC__VK_BIND_TLAS 18u   /* the ray query kernel's acceleration structure */
 #define RC__VK_MAX_CHUNKS 4u
 
 /* Values of the MODEL specialization constant. */

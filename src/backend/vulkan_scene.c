@@ -9,6 +9,8 @@
  * load picks its binding: a cost on masked-execution devices like lavapipe). A scene that needs more fails with RC_ERR_OUT_OF_MEMORY naming the
  * array and the limit; so does one that does not fit the device heap, which is
  * checked before allocating so it never reaches the driver's limits.
+ * With the ray query traversal the commit also builds the driver's
+ * acceleration structures (vulkan_accel.c).
  * Arena use: the rc__vk_scene record plus the BVH (rc__scene_bvh_commit_bytes). */
 #include "backend/vulkan_internal.h"
 
@@ -30,6 +32,7 @@ static void release_buffers(rc__vk_state *st, rc__vk_scene *sv)
     rc__vk_buffer_destroy(st, &sv->refs);
     rc__vk_buffer_destroy(st, &sv->geoms);
     rc__vk_buffer_destroy(st, &sv->insts);
+    rc__vk_accel_release(st, sv);
     sv->node_chunks = sv->tri_chunks = sv->vert_chunks = sv->chunked = 0;
     memset(&sv->info, 0, sizeof sv->info);
 }
@@ -191,6 +194,7 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
                 s = rc__vk_copy(st, &staging, &arrays[a].bufs[c], arrays[a].staging_off[c], bytes);
         }
     rc__vk_buffer_destroy(st, &staging);
+    if (s == RC_OK && st->ray_query) s = rc__vk_accel_build(scene, serial);
     if (s != RC_OK) goto fail;
     sv->info = info;
     return RC_OK;

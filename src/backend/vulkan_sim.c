@@ -16,13 +16,22 @@
 
 #include <string.h>
 
+static void layout_binding(VkDescriptorSetLayoutBinding *b, uint32_t binding, VkDescriptorType type)
+{
+    memset(b, 0, sizeof *b);
+    b->binding = binding;
+    b->descriptorType = type;
+    b->descriptorCount = 1;
+    b->stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+}
+
 rc_status rc__vk_pipelines_create(rc__vk_state *st)
 {
-    VkDescriptorSetLayoutBinding b[RC__VK_BINDINGS];
+    VkDescriptorSetLayoutBinding b[RC__VK_BINDINGS + 1u];
     VkDescriptorSetLayoutCreateInfo sli;
     VkPushConstantRange pcr;
     VkPipelineLayoutCreateInfo pli;
-    VkDescriptorPoolSize ps;
+    VkDescriptorPoolSize ps[2];
     VkDescriptorPoolCreateInfo dpi;
     VkShaderModuleCreateInfo smi;
     VkPipelineCacheCreateInfo pci;
@@ -32,13 +41,9 @@ rc_status rc__vk_pipelines_create(rc__vk_state *st)
     for (i = 0; i < RC__VK_BINDINGS; ++i) {
         const int chunk_slot = i < 12u && (i % 4u) != 0u;
         if (chunk_slot && st->chunks == 1) continue; /* the 1-binding kernel declares only 0, 4, 8 */
-        memset(&b[n], 0, sizeof b[n]);
-        b[n].binding = i;
-        b[n].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        b[n].descriptorCount = 1;
-        b[n].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-        ++n;
+        layout_binding(&b[n++], i, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER);
     }
+    if (st->ray_query) layout_binding(&b[n++], RC__VK_BIND_TLAS, VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR);
     memset(&sli, 0, sizeof sli);
     sli.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
     sli.bindingCount = n;
@@ -55,18 +60,20 @@ rc_status rc__vk_pipelines_create(rc__vk_state *st)
     pli.pushConstantRangeCount = 1;
     pli.pPushConstantRanges = &pcr;
     RC__VK_TRY(st, vkCreatePipelineLayout(st->device, &pli, RC__VK_OBJ_ALLOC, &st->pipe_layout), "vkCreatePipelineLayout");
-    ps.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    ps.descriptorCount = (RC__VK_SLOTS + 1u) * RC__VK_BINDINGS;
+    ps[0].type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    ps[0].descriptorCount = (RC__VK_SLOTS + 1u) * RC__VK_BINDINGS;
+    ps[1].type = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
+    ps[1].descriptorCount = RC__VK_SLOTS + 1u;
     memset(&dpi, 0, sizeof dpi);
     dpi.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO;
     dpi.maxSets = RC__VK_SLOTS + 1u;
-    dpi.poolSizeCount = 1;
-    dpi.pPoolSizes = &ps;
+    dpi.poolSizeCount = st->ray_query ? 2u : 1u;
+    dpi.pPoolSizes = ps;
     RC__VK_TRY(st, vkCreateDescriptorPool(st->device, &dpi, RC__VK_OBJ_ALLOC, &st->desc_pool), "vkCreateDescriptorPool");
     for (i = 0; i < (st->chunks > 1 ? 2u : 1u); ++i) {
         memset(&smi, 0, sizeof smi);
         smi.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-        smi.pCode = rc__vk_raycast_spirv((int)st->fp64, i ? RC__VK_MAX_CHUNKS : 1u, &bytes);
+        smi.pCode = rc__vk_raycast_spirv((int)st->fp64, i ? RC__VK_MAX_CHUNKS : 1u, (int)st->ray_query, &bytes);
         smi.codeSize = bytes;
         RC__VK_TRY(st, vkCreateShaderModule(st->device, &smi, RC__VK_OBJ_ALLOC, &st->module[i]), "vkCreateShaderModule");
     }
@@ -167,7 +174,8 @@ static void write_sets(rc__vk_state *st, const rc__vk_scene *sv, const rc__vk_se
                        const rc__vk_buffer *out)
 {
     VkDescriptorBufferInfo info[RC__VK_BINDINGS];
-    VkWriteDescriptorSet w[RC__VK_BINDINGS];
+    VkWriteDescriptorSet w[RC__VK_BINDINGS + 1u];
+    VkWriteDescriptorSetAccelerationStructureKHR wa;
     uint32_t i, n = 0;
     for (i = 0; i < RC__VK_BINDINGS; ++i) {
         const rc__vk_buffer *b;
@@ -201,6 +209,20 @@ static void write_sets(rc__vk_state *st, const rc__vk_scene *sv, const rc__vk_se
         w[n].descriptorCount = 1;
         w[n].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
         w[n].pBufferInfo = &info[n];
+        ++n;
+    }
+    if (st->ray_query) {
+        memset(&wa, 0, sizeof wa);
+        wa.sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR;
+        wa.accelerationStructureCount = 1;
+        wa.pAccelerationStructures = &sv->tlas.as;
+        memset(&w[n], 0, sizeof w[n]);
+        w[n].sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET;
+        w[n].pNext = &wa;
+        w[n].dstSet = set;
+        w[n].dstBinding = RC__VK_BIND_TLAS;
+        w[n].descriptorCount = 1;
+        w[n].descriptorType = VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
         ++n;
     }
     vkUpdateDescriptorSets(st->device, n, w, 0, NULL);
@@ -306,8 +328,9 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
     unsigned char *xf;
     const int on_device = (job->flags & RC_RESULTS_ON_DEVICE) != 0;
 
-    RC_RETURN_IF(st->ctx, sv == NULL || sv->refs.buf == VK_NULL_HANDLE, RC_ERR_NOT_COMMITTED,
-                 "vulkan: the scene has no device copy; commit it");
+    RC_RETURN_IF(st->ctx, sv == NULL || sv->refs.buf == VK_NULL_HANDLE ||
+                              (st->ray_query && sv->tlas.as == VK_NULL_HANDLE),
+                 RC_ERR_NOT_COMMITTED, "vulkan: the scene has no device copy; commit it");
     RC_RETURN_IF(st->ctx, rays > 0x80000000u, RC_ERR_UNSUPPORTED, "vulkan: sensors of more than 2^31 rays");
     RC_TRY(rc__vk_sensor_table(st, sensor, &table));
     RC_TRY(get_pipeline(st, job->attributes, table->model, sv->chunked, &pipe));

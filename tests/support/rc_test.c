@@ -14,6 +14,12 @@ int rct_quick(void)
     return q && q[0] && q[0] != '0';
 }
 
+int rct_env_on(const char *name)
+{
+    const char *v = getenv(name);
+    return v && v[0] && v[0] != '0';
+}
+
 int rct_backend_usable(uint32_t backend)
 {
     rc_context_desc d = rc_context_desc_default();
@@ -32,6 +38,9 @@ int rct_backend_usable(uint32_t backend)
     d.thread_count = 1;
     d.memory_size = (size_t)1 << 20;
     st = rc_context_create(&d, &ctx);
+    if (st != RC_OK && backend == RC_BACKEND_VULKAN && rct_env_on("RC_TEST_REQUIRE_RAY_QUERY"))
+        fail_msg("backend vulkan is required here (RC_TEST_REQUIRE_RAY_QUERY) but not usable: %s",
+                 rc_status_string(st));
     if (st != RC_OK) {
         print_message("SKIP: backend %s is built in but not usable here: %s\n", rc_backend_name(backend),
                       rc_status_string(st));

@@ -77,5 +77,11 @@ void *rct_alloc16(size_t size);
 
 /* Environment switch for sanitizer/valgrind runs: smaller workloads. */
 int rct_quick(void);
+/* 1 when the environment variable is set to something other than "" or "0".
+ * RANGECAST_VULKAN_RAY_QUERY=1 (read by the library) puts every Vulkan
+ * context on the ray query traversal; RC_TEST_REQUIRE_RAY_QUERY=1 turns an
+ * unusable Vulkan backend from a skip into a failure (the ray query runs of
+ * tests/CMakeLists.txt). */
+int rct_env_on(const char *name);
 
 #endif

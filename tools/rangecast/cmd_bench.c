@@ -51,6 +51,8 @@ static void usage(FILE *f)
         "                     each ray from its beam origin, 0.3 .. 120 m)\n"
         "  --backend B        auto (default), bvh, embree, vulkan; embree-single: a plain rtcIntersect1 loop\n"
         "  --device NAME      vulkan: device index or name substring (default: first GPU, else any)\n"
+        "  --vulkan-traversal T  vulkan: compute (default: the kernel's own BVH walk) or ray-query\n"
+        "                     (VK_KHR_ray_query on the driver's structures, RC_CONTEXT_VULKAN_RAY_QUERY)\n"
         "  --build-quality Q  balanced (default), fast, high, compact: rc_scene_desc.build_quality\n"
         "                     (Embree's build; the built-in backend has one build)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
@@ -65,7 +67,7 @@ static void usage(FILE *f)
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
         "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
-        "build_quality baked_map_bytes.\n"
+        "build_quality baked_map_bytes vulkan_traversal.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
         "A baked map (.rcmap, rangecast bake) is loaded in place: build_s is then the load\n"
@@ -263,6 +265,14 @@ static int parse_args(int argc, char **argv, bench_args *a)
         } else if (OPT("--device")) {
             if (r < 0) return -1;
             rcp_device = v;
+        } else if (OPT("--vulkan-traversal")) {
+            if (r < 0) return -1;
+            if (strcmp(v, "compute") == 0)
+                rcp_context_flags &= ~RC_CONTEXT_VULKAN_RAY_QUERY;
+            else if (strcmp(v, "ray-query") == 0)
+                rcp_context_flags |= RC_CONTEXT_VULKAN_RAY_QUERY;
+            else
+                return rcp_usage_error(cmd, "--vulkan-traversal: expected compute or ray-query, got '%s'", v), -1;
         } else if (OPT("--build-quality")) {
             if (r < 0) return -1;
             if (rcp_parse_build_quality(cmd, v, &rcp_build_quality) != 0) return -1;
@@ -670,8 +680,13 @@ int rcp_cmd_bench(int argc, char **argv)
         printf(",\"ranges_consistent\":%s,\"build_quality\":\"%s\",\"baked_map_bytes\":",
                acc.differing == 0 && acc.inconsistent == 0 && acc.bad_prims == 0 ? "true" : "false",
                rcp_build_quality_name(rcp_build_quality));
-        if (rcp_baked_of(&mesh)) printf("%llu}\n", (unsigned long long)rcp_baked_of(&mesh)->bytes);
-        else printf("null}\n");
+        if (rcp_baked_of(&mesh)) printf("%llu", (unsigned long long)rcp_baked_of(&mesh)->bytes);
+        else printf("null");
+        if (w.backend == RC_BACKEND_VULKAN)
+            printf(",\"vulkan_traversal\":\"%s\"}\n",
+                   (rcp_context_flags & RC_CONTEXT_VULKAN_RAY_QUERY) ? "ray-query" : "compute");
+        else
+            printf(",\"vulkan_traversal\":null}\n");
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;

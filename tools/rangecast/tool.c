@@ -260,6 +260,7 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
     uint32_t k;
     cd.backend = backend;
     cd.device = rcp_device;
+    cd.flags = rcp_context_flags;
     cd.thread_count = threads;
     if ((st = rc_context_memory_requirements(&cd, &ctx_bytes)) != RC_OK)
         return rcp_lib_error(cmd, NULL, "rc_context_memory_requirements", st);
@@ -345,6 +346,7 @@ void rcp_world_destroy(rcp_world *world)
 }
 
 const char *rcp_device = NULL;
+uint32_t rcp_context_flags = 0;
 
 /* Bytes a sensor of the caller's rays adds to rcp_arena_bytes' figure. */
 static int rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes)
@@ -390,6 +392,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     }
     cd.backend = backend;
     cd.device = rcp_device;
+    cd.flags = rcp_context_flags;
     cd.thread_count = threads;
     cd.memory = NULL;             /* the library mallocs exactly this much, once */
     cd.memory_size = w->arena_bytes;

@@ -81,6 +81,9 @@ typedef struct rcp_world {
  * RCP_EXIT_FAIL with *world cleaned up. */
 /* --device of bench/simulate: the Vulkan device (rc_context_desc.device); NULL = default. */
 extern const char *rcp_device;
+/* rc_context_desc.flags of the contexts the commands make (bench
+ * --vulkan-traversal ray-query: RC_CONTEXT_VULKAN_RAY_QUERY). */
+extern uint32_t rcp_context_flags;
 /* --build-quality of bench: the scene's rc_scene_desc.build_quality (RC_BUILD_*). */
 extern uint32_t rcp_build_quality;
 
