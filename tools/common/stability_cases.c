@@ -674,6 +674,7 @@ static int run_spec(const stab_spec *s, const rcu_stab_options *opt, rcu_stab_re
         goto done;
     }
     cd.backend = opt->backend;
+    cd.flags = opt->context_flags;
     cd.thread_count = opt->threads;
     cd.memory_size = (size_t)64 << 20;
 #define LIB(expr)                              \

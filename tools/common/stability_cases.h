@@ -38,6 +38,7 @@ typedef void (*rcu_stab_configure_fn)(rc_context *ctx, void *user);
 
 typedef struct rcu_stab_options {
     uint32_t backend;        /* RC_BACKEND_* */
+    uint32_t context_flags;  /* rc_context_desc.flags (RC_CONTEXT_VULKAN_RAY_QUERY) */
     uint32_t threads;        /* library threads (0 = all CPUs) */
     int quick;               /* smaller sizes (sanitizer runs) */
     rcu_stab_configure_fn configure; /* optional */

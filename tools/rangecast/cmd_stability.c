@@ -23,7 +23,8 @@ static void usage(FILE *f)
         "zero-area triangle, or (coplanar case) its ids are not the smallest key.\n"
         "\n"
         "Options:\n"
-        "  --backend LIST   comma-separated: bvh, embree, vulkan, auto (the one auto picks)\n"
+        "  --backend LIST   comma-separated: bvh, embree, vulkan, auto (the one auto picks);\n"
+        "                   vulkan-rq: vulkan with its ray query traversal (RC_CONTEXT_VULKAN_RAY_QUERY)\n"
         "                   (default: every backend built in)\n"
         "  --threads N      library threads (default 2)\n"
         "  --quick          the smaller sizes the sanitizer runs use\n"
@@ -34,7 +35,8 @@ static void usage(FILE *f)
 int rcp_cmd_stability(int argc, char **argv)
 {
     const char *cmd = "stability";
-    uint32_t backends[4], nb = 0, threads = 2, b;
+    uint32_t backends[4], flags[4] = {0, 0, 0, 0}, nb = 0, threads = 2, b;
+    const char *names[4];
     int markdown = 0, quick = 0, listed = 0, i, r, c, any_wrong = 0;
     static rcu_stab_result results[4][RCU_STAB_CASE_COUNT];
     int ran[4][RCU_STAB_CASE_COUNT];
@@ -51,7 +53,12 @@ int rcp_cmd_stability(int argc, char **argv)
             listed = 1;
             for (tok = strtok_r(buf, ",", &save); tok; tok = strtok_r(NULL, ",", &save)) {
                 if (nb == 4) return rcp_usage_error(cmd, "--backend: at most 4 backends");
-                if (rcp_parse_backend(cmd, tok, &backends[nb]) != 0) return RCP_EXIT_USAGE;
+                if (strcmp(tok, "vulkan-rq") == 0) {
+                    backends[nb] = RC_BACKEND_VULKAN;
+                    flags[nb] = RC_CONTEXT_VULKAN_RAY_QUERY;
+                } else if (rcp_parse_backend(cmd, tok, &backends[nb]) != 0) {
+                    return RCP_EXIT_USAGE;
+                }
                 nb++;
             }
         } else if ((r = rcp_opt_threads(cmd, argc, argv, &i, &threads)) != 0) {
@@ -78,17 +85,19 @@ int rcp_cmd_stability(int argc, char **argv)
         for (b = 0; b < 3; b++)
             if (rc_backend_available(all[b])) backends[nb++] = all[b];
     }
+    for (b = 0; b < nb; b++) names[b] = flags[b] ? "vulkan-rq" : rc_backend_name(backends[b]);
     for (b = 0; b < nb; b++)
         for (c = 0; c < RCU_STAB_CASE_COUNT; c++) {
             rcu_stab_options opt;
             memset(&opt, 0, sizeof opt);
             opt.backend = backends[b];
+            opt.context_flags = flags[b];
             opt.threads = threads;
             opt.quick = quick;
             ran[b][c] = rcu_stab_run(c, &opt, &results[b][c]) == 0;
             if (!ran[b][c]) {
-                fprintf(stderr, "rangecast stability: %s on %s: %s\n", rcu_stab_case_name(c),
-                        rc_backend_name(backends[b]), results[b][c].note);
+                fprintf(stderr, "rangecast stability: %s on %s: %s\n", rcu_stab_case_name(c), names[b],
+                        results[b][c].note);
                 any_wrong = 1;
             } else if (results[b][c].wrong) {
                 any_wrong = 1;
@@ -96,14 +105,13 @@ int rcp_cmd_stability(int argc, char **argv)
         }
     if (markdown) {
         printf("| case |");
-        for (b = 0; b < nb; b++) printf(" %s: wrong / rays | %s: max error [m] |", rc_backend_name(backends[b]),
-                                        rc_backend_name(backends[b]));
+        for (b = 0; b < nb; b++) printf(" %s: wrong / rays | %s: max error [m] |", names[b], names[b]);
         printf(" tolerance |\n|---|");
         for (b = 0; b < nb; b++) printf("---:|---:|");
         printf("---|\n");
     } else {
         printf("%-16s", "case");
-        for (b = 0; b < nb; b++) printf(" %10s wrong/rays %10s", rc_backend_name(backends[b]), "max err");
+        for (b = 0; b < nb; b++) printf(" %10s wrong/rays %10s", names[b], "max err");
         printf("  tolerance\n");
     }
     for (c = 0; c < RCU_STAB_CASE_COUNT; c++) {
@@ -133,7 +141,7 @@ int rcp_cmd_stability(int argc, char **argv)
                                   "zero-area hits %llu, ids %llu); first: %s\n"
                                 : "%s/%s: %llu wrong (class %llu, range %llu, NaN %llu, normals %llu, "
                                   "zero-area hits %llu, ids %llu); first: %s\n",
-                       rc_backend_name(backends[b]), rcu_stab_case_name(c), (unsigned long long)s->wrong,
+                       names[b], rcu_stab_case_name(c), (unsigned long long)s->wrong,
                        (unsigned long long)s->class_mismatch, (unsigned long long)s->range_errors,
                        (unsigned long long)s->nan_outputs, (unsigned long long)s->bad_normals,
                        (unsigned long long)s->degenerate_hits, (unsigned long long)s->key_mismatch, s->note);
