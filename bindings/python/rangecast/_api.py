@@ -119,11 +119,16 @@ class Context(object):
     generously here. device: Vulkan device index or name substring.
     budget_mib: most memory Embree or Vulkan may hold outside the arena.
     log: a callable(level, message) for the library's log lines.
+    vulkan_ray_query: backend "vulkan" only: trace with VK_KHR_ray_query on
+    the driver's acceleration structures (RC_CONTEXT_VULKAN_RAY_QUERY);
+    Error(ERR_UNSUPPORTED) on a device without it.
     """
 
-    def __init__(self, backend="auto", threads=0, arena_bytes=0, device=None, budget_mib=0, log=None):
+    def __init__(self, backend="auto", threads=0, arena_bytes=0, device=None, budget_mib=0, log=None,
+                 vulkan_ray_query=False):
         desc = F.lib.rc_context_desc_default()
         desc.backend = _lookup(_BACKENDS, backend, "backend")
+        desc.flags = F.CONTEXT_VULKAN_RAY_QUERY if vulkan_ray_query else 0
         desc.thread_count = _u32(threads, "threads")
         desc.memory_size = int(arena_bytes)
         desc.backend_budget_mib = _u32(budget_mib, "budget_mib")

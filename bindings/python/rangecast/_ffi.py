@@ -73,6 +73,8 @@ ATTR_INST_IDS = 0x40
 
 INVALID_ID = 0xFFFFFFFF
 
+CONTEXT_VULKAN_RAY_QUERY = 0x1
+
 BAKED_MAP_VERSION = 1      # RC_BAKED_MAP_VERSION: the blob format the library writes and reads
 BAKED_SKIP_CHECKSUM = 1    # rc_scene_load_baked flag
 BAKED_ALIGN = 16           # rc_scene_load_baked wants the blob on a 16-byte boundary

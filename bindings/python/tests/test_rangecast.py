@@ -299,6 +299,27 @@ class TestAgreement(unittest.TestCase):
                 np.testing.assert_allclose(got, ref, rtol=1e-5)
 
 
+    def test_vulkan_ray_query_agrees_or_is_refused(self):
+        with self.assertRaises(Error) as cm:
+            rangecast.Context("bvh", vulkan_ray_query=True)
+        self.assertEqual(cm.exception.status, F.ERR_INVALID_ARGUMENT)
+        self.assertIn("RC_CONTEXT_VULKAN_RAY_QUERY", str(cm.exception))
+        if not rangecast.backend_available("vulkan"):
+            self.skipTest("no Vulkan backend built in")
+        try:
+            ctx = rangecast.Context("vulkan", threads=2, vulkan_ray_query=True)
+        except Error as e:
+            required = os.environ.get("RC_TEST_REQUIRE_RAY_QUERY", "0") not in ("", "0")
+            if required or e.status != F.ERR_UNSUPPORTED or "RC_CONTEXT_VULKAN_RAY_QUERY" not in str(e):
+                raise
+            self.skipTest("this device has no ray query: %s" % e)
+        with ctx:
+            scene = ctx.mesh_scene(*uv_sphere(20.0, 60, 120))
+            got = ctx.simulate(scene, ctx.preset_sensor("vlp16"), self.poses(), ("ranges",))["ranges"]
+        ref = self.scan("bvh", 2, self.poses())["ranges"]
+        np.testing.assert_allclose(got, ref, rtol=1e-5)
+
+
 class TestThreads(Base):
     def test_python_threads_share_a_context_one_call_at_a_time(self):
         import threading
