@@ -18,6 +18,7 @@
 #include <string.h>
 
 #include "cloud.h"
+#include "ouster_frame.h"
 #include "poses.h"
 #include "util.h"
 
@@ -266,6 +267,46 @@ static void test_cloud_files(void **state)
     rcu_cloud_free(&c);
 }
 
+/* An Ouster frame: the column window (wrapping or not) and destaggering as
+ * the SDK does it, on a 3 x 5 field with known values. */
+static void test_ouster_frame(void **state)
+{
+    const int32_t shift[3] = {0, 2, -1};
+    float in[15], out[15], ranges[15], points[45];
+    uint8_t hits[15];
+    uint32_t u, v;
+    (void)state;
+    assert_true(rcu_ouster_in_window(0, 0, 4) && rcu_ouster_in_window(4, 0, 4));
+    assert_true(rcu_ouster_in_window(2, 1, 3) && !rcu_ouster_in_window(0, 1, 3) && !rcu_ouster_in_window(4, 1, 3));
+    /* [3, 1] wraps: 3, 4, 0, 1 */
+    assert_true(rcu_ouster_in_window(3, 3, 1) && rcu_ouster_in_window(4, 3, 1) && rcu_ouster_in_window(0, 3, 1));
+    assert_true(rcu_ouster_in_window(1, 3, 1) && !rcu_ouster_in_window(2, 3, 1));
+    for (u = 0; u < 15; ++u) {
+        in[u] = (float)(10 * (u / 5) + u % 5); /* row * 10 + column */
+        ranges[u] = 1.0f;
+        hits[u] = 1;
+        points[3 * u] = points[3 * u + 1] = points[3 * u + 2] = 2.0f;
+    }
+    assert_int_equal(rcu_ouster_mask_window(3, 5, 3, 1, hits, ranges, points), 3);
+    for (u = 0; u < 3; ++u)
+        for (v = 0; v < 5; ++v) {
+            const uint32_t k = u * 5 + v;
+            if (v == 2) {
+                assert_int_equal(hits[k], 0);
+                assert_true(isnan(ranges[k]) && isnan(points[3 * k]) && isnan(points[3 * k + 2]));
+            } else {
+                assert_int_equal(hits[k], 1);
+                assert_true(ranges[k] == 1.0f && points[3 * k + 1] == 2.0f);
+            }
+        }
+    assert_int_equal(rcu_ouster_mask_window(3, 5, 0, 4, NULL, ranges, NULL), 0);
+    /* out[u][(v + shift[u]) mod 5] = in[u][v] */
+    rcu_ouster_destagger(in, out, 3, 5, shift);
+    for (u = 0; u < 3; ++u)
+        for (v = 0; v < 5; ++v) assert_true(out[u * 5 + (uint32_t)((v + 5 + shift[u]) % 5)] == in[u * 5 + v]);
+    assert_true(out[5 + 2] == 10.0f && out[10 + 4] == 20.0f && out[0] == 0.0f);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -275,6 +316,7 @@ int main(void)
         cmocka_unit_test(test_cloud_keeps_returns_and_fields),
         cmocka_unit_test(test_cloud_map_frame),
         cmocka_unit_test(test_cloud_files),
+        cmocka_unit_test(test_ouster_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

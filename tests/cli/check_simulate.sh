@@ -249,6 +249,23 @@ EOF
     grep -qx "POINTS 8" legacy.pcd || fail "legacy Ouster metadata: point count"
     awk 'f { if ($3 > 1e-4 || $3 < -1e-4 || $4 < 19.5 || $4 > 20.0001) { print "legacy point " $0; bad = 1 } }
          /^DATA/ { f = 1 } END { exit bad }' legacy.pcd || fail "legacy.pcd contents"
+    # the frame: column_window [3, 0] wraps past the last column (ids 3 and 0
+    # measured, 1 and 2 not), pixel_shift_by_row destaggers --image
+    cat >window.json <<'EOF'
+{"beam_altitude_angles": [0.0, 0.0], "beam_azimuth_angles": [0.0, 45.0], "lidar_mode": "4x10",
+ "column_window": [3, 0], "pixel_shift_by_row": [1, -1]}
+EOF
+    run 0 "" "$RC" simulate --map sphere.ply --pose 0,0,0 -o window.pcd --ascii --fields range,ring \
+        --sensor ouster:window.json --image window.png $BACKEND
+    grep -qx "POINTS 4" window.pcd || fail "Ouster column_window: point count"
+    [ -s window.png ] || [ -s window.pgm ] || [ -s window.ppm ] || fail "Ouster --image with pixel_shift_by_row"
+    sed 's/\[1, -1\]/[1]/' window.json >short_shift.json
+    run 1 "pixel_shift_by_row must be one integer a beam" "$RC" simulate --map sphere.ply --pose 0,0,0 \
+        -o s.pcd --sensor ouster:short_shift.json
+    sed 's/\[3, 0\]/[3, 4]/' window.json >wide_window.json
+    run 1 "column_window must be two column indices" "$RC" simulate --map sphere.ply --pose 0,0,0 \
+        -o w.pcd --sensor ouster:wide_window.json
+    [ ! -e s.pcd ] && [ ! -e w.pcd ] || fail "a run on a bad Ouster frame wrote a cloud"
     echo '{"lidar_mode": "512x10"}' >no_beams.json
     run 1 "beam_altitude_angles" "$RC" simulate --map sphere.ply --pose 0,0,0 -o p.pcd --sensor ouster:no_beams.json
     echo '[1, 2]' >array.json

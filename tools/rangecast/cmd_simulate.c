@@ -8,6 +8,7 @@
 
 #include "cloud.h"
 #include "mesh_load.h"
+#include "ouster_frame.h"
 #include "ouster_json.h"
 #include "poses.h"
 #include "range_image.h"
@@ -32,7 +33,9 @@ static void usage(FILE *f)
         "  --sensor NAME       vlp16 (default), vlp16-360, os1-64, d435, livox-mid40;\n"
         "                      ouster:FILE.json: an Ouster unit from its metadata (rc_ouster_rays: each\n"
         "                      ray from its beam origin; rows are beams, columns measurement ids;\n"
-        "                      range is from the beam origin, 0.3 .. 120 m)\n"
+        "                      range is from the beam origin, 0.3 .. 120 m). Columns outside the\n"
+        "                      metadata's column_window return nothing, and --image is destaggered\n"
+        "                      by its pixel_shift_by_row (as Ouster's SDK shows a frame)\n"
         "  --backend B         auto (default), bvh, embree, vulkan\n"
         "  --threads N         worker threads, 0 = all CPUs (default)\n"
         "  -o, --output OUT    .ply or .pcd (binary unless --ascii)\n"
@@ -240,7 +243,7 @@ int rcp_cmd_simulate(int argc, char **argv)
     rcu_cloud cloud;
     rcu_preset_rays ref;
     rcp_rays ou;
-    float *points = NULL, *ranges = NULL, *normals = NULL;
+    float *points = NULL, *ranges = NULL, *normals = NULL, *image = NULL;
     uint8_t *hits = NULL;
     double t_sim = 0.0;
     int rc = RCP_EXIT_FAIL;
@@ -321,6 +324,12 @@ int rcp_cmd_simulate(int argc, char **argv)
             goto done;
         }
         t_sim += rcu_now() - t0;
+        if (a.ouster_path) { /* the frame's column window: no data outside it */
+            uint32_t s;
+            for (s = 0; s < n; ++s)
+                rcu_ouster_mask_window(ou.height, ou.width, ou.window_start, ou.window_end, hits + (size_t)s * rays,
+                                       ranges + (size_t)s * rays, points + (size_t)s * rays * 3u);
+        }
         memset(&view, 0, sizeof view);
         view.points = points;
         view.hits = hits;
@@ -335,8 +344,19 @@ int rcp_cmd_simulate(int argc, char **argv)
             rcp_fail(cmd, "%s", rcu_last_error());
             goto done;
         }
-        if (p == 0 && a.image && write_image(cmd, a.image, a.preset, &si, ranges, a.image_mode) != 0)
-            goto done;
+        if (p == 0 && a.image) {
+            const float *shown = ranges;
+            if (a.ouster_path && ou.pixel_shift) { /* destaggered, as the SDK shows a frame */
+                image = (float *)malloc((size_t)rays * sizeof(float));
+                if (!image) {
+                    rcp_fail(cmd, "out of memory for the destaggered image");
+                    goto done;
+                }
+                rcu_ouster_destagger(ranges, image, ou.height, ou.width, ou.pixel_shift);
+                shown = image;
+            }
+            if (write_image(cmd, a.image, a.preset, &si, shown, a.image_mode) != 0) goto done;
+        }
     }
     if (rcu_cloud_write(a.out, &cloud, a.ascii) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
@@ -360,6 +380,7 @@ done:
     rcu_cloud_free(&cloud);
     free(points);
     free(ranges);
+    free(image);
     free(hits);
     free(normals);
     free(poses);

@@ -11,6 +11,7 @@ void rcp_rays_free(rcp_rays *rays)
     if (!rays) return;
     free(rays->origins);
     free(rays->dirs);
+    free(rays->pixel_shift);
     memset(rays, 0, sizeof *rays);
 }
 
@@ -75,6 +76,50 @@ static uint32_t columns_of(const cJSON *root)
     return 0;
 }
 
+/* lidar_data_format's name, else data_format's (older firmware). */
+static const cJSON *format_field(const cJSON *root, const char *name)
+{
+    const cJSON *c = field(root, "lidar_data_format", name);
+    return c ? c : field(root, "data_format", name);
+}
+
+/* pixel_shift_by_row and column_window into out (width and height set);
+ * NULL, or what is wrong with them. */
+static const char *frame_of(const cJSON *root, rcp_rays *out)
+{
+    const cJSON *shift = format_field(root, "pixel_shift_by_row"), *win = format_field(root, "column_window");
+    out->window_start = 0;
+    out->window_end = out->width - 1u;
+    if (shift) {
+        uint32_t n = out->height, u;
+        double *v = numbers(shift, &n);
+        if (!v) return "pixel_shift_by_row must be one integer a beam";
+        out->pixel_shift = (int32_t *)malloc(sizeof(int32_t) * n);
+        for (u = 0; out->pixel_shift && u < n; ++u) {
+            if (v[u] != (double)(int32_t)v[u] || v[u] < -65536.0 || v[u] > 65536.0) {
+                free(v);
+                return "pixel_shift_by_row must be one integer a beam";
+            }
+            out->pixel_shift[u] = (int32_t)v[u];
+        }
+        free(v);
+        if (!out->pixel_shift) return "out of memory for pixel_shift_by_row";
+    }
+    if (win) {
+        uint32_t two = 2;
+        double *v = numbers(win, &two);
+        const int ok = v && v[0] >= 0 && v[1] >= 0 && v[0] < out->width && v[1] < out->width &&
+                       v[0] == (double)(uint32_t)v[0] && v[1] == (double)(uint32_t)v[1];
+        if (ok) {
+            out->window_start = (uint32_t)v[0];
+            out->window_end = (uint32_t)v[1];
+        }
+        free(v);
+        if (!ok) return "column_window must be two column indices [start, end] below columns_per_frame";
+    }
+    return NULL;
+}
+
 int rcp_ouster_load(const char *path, rcp_rays *out)
 {
     unsigned char *text = NULL;
@@ -128,6 +173,11 @@ int rcp_ouster_load(const char *path, rcp_rays *out)
         else if ((st = rc_ouster_rays(&d, &rd, out->origins, out->dirs, NULL)) != RC_OK)
             problem = "rc_ouster_rays refused its values (a transform that is not rigid, a non-finite number, "
                       "or more than 2^24 rays)";
+    }
+    if (!problem) {
+        out->width = rd.width;
+        out->height = rd.height;
+        problem = frame_of(root, out);
     }
     free(alt);
     free(azi);

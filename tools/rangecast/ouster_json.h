@@ -14,13 +14,20 @@ typedef struct rcp_rays {
     float *origins, *dirs;      /* 3 floats a ray (malloc'd) */
     uint32_t count, width, height;
     float range_min, range_max;
+    /* an Ouster frame (tools/common/ouster_frame.h): pixel_shift_by_row, one
+     * a row (malloc'd; NULL when the metadata has none), and column_window,
+     * inclusive (0 .. width - 1 when the metadata has none) */
+    int32_t *pixel_shift;
+    uint32_t window_start, window_end;
 } rcp_rays;
 
 /* The prefix that names an Ouster metadata file in --sensor. */
 #define RCP_OUSTER_PREFIX "ouster:"
 
 /* Reads path into out (range 0.3 .. 120 m, an OS1's: the metadata has no
- * limits). 0, or -1 with rcu_last_error() naming the file and the problem. */
+ * limits), with the frame's pixel_shift_by_row and column_window where the
+ * metadata has them (lidar_data_format, or data_format). 0, or -1 with
+ * rcu_last_error() naming the file and the problem. */
 int rcp_ouster_load(const char *path, rcp_rays *out);
 
 void rcp_rays_free(rcp_rays *rays);

@@ -5,6 +5,7 @@ writes, turned into a rays sensor whose every ray leaves its own beam origin.
     lidar = rangecast.ouster.sensor(ctx, meta)           # rows = beams, columns = measurement ids
     scan = ctx.simulate(scene, lidar, pose, ("ranges", "points"))
     r = rangecast.ouster.sensor_ranges(scan["ranges"], meta)   # what the sensor would report
+    image = rangecast.ouster.destagger(r, meta)                # as Ouster's SDK shows a frame
 
 The rays come from the C library's rc_ouster_rays (include/rangecast/rangecast.h),
 which follows the geometry Ouster documents for turning a range image into
@@ -40,7 +41,7 @@ import numpy as np
 from . import _ffi as F
 from ._api import Error
 
-__all__ = ["read_metadata", "rays", "sensor", "sensor_ranges"]
+__all__ = ["read_metadata", "rays", "sensor", "sensor_ranges", "window_mask", "destagger"]
 
 # Ouster's default lidar-to-sensor transform (the lidar frame turned 180
 # degrees about z, 36.18 mm up), for metadata that does not carry one.
@@ -58,7 +59,9 @@ def read_metadata(source):
     """The parts of Ouster metadata that place the rays, from a path, a JSON
     string or an already parsed dict: a dict with altitudes and azimuths
     (degrees, one per beam), columns (measurement ids a frame), beam_to_lidar
-    and lidar_to_sensor (4x4, mm) and prod_line. ValueError names what is
+    and lidar_to_sensor (4x4, mm), prod_line, pixel_shift (one int a beam,
+    from pixel_shift_by_row; None when absent) and column_window ((start,
+    end) inclusive, the whole frame when absent). ValueError names what is
     missing or malformed."""
     if isinstance(source, dict):
         raw = source
@@ -99,9 +102,22 @@ def read_metadata(source):
         beam_to_lidar[0, 3] = float(beams.get("lidar_origin_to_beam_origin_mm", 0.0))
     lidar_to_sensor = _matrix(lidar.get("lidar_to_sensor_transform", _DEFAULT_LIDAR_TO_SENSOR),
                               "lidar_to_sensor_transform")
-    return {"altitudes": altitudes, "azimuths": azimuths, "columns": int(columns),
+    columns = int(columns)
+    shift = fmt.get("pixel_shift_by_row", raw.get("pixel_shift_by_row"))
+    if shift is not None:
+        shift = np.asarray(shift)
+        if shift.shape != altitudes.shape or not np.all(np.equal(np.mod(shift, 1), 0)):
+            raise ValueError("ouster metadata: pixel_shift_by_row must be one integer a beam (%d), got %r"
+                             % (altitudes.size, fmt.get("pixel_shift_by_row")))
+        shift = shift.astype(np.int64)
+    window = fmt.get("column_window", raw.get("column_window", [0, columns - 1]))
+    if (len(window) != 2 or any(int(c) != c or c < 0 or c >= columns for c in window)):
+        raise ValueError("ouster metadata: column_window must be two column indices [start, end] below "
+                         "columns_per_frame (%d), got %r" % (columns, window))
+    return {"altitudes": altitudes, "azimuths": azimuths, "columns": columns,
             "beam_to_lidar": beam_to_lidar, "lidar_to_sensor": lidar_to_sensor,
-            "prod_line": str(info.get("prod_line", ""))}
+            "prod_line": str(info.get("prod_line", "")), "pixel_shift": shift,
+            "column_window": (int(window[0]), int(window[1]))}
 
 
 def _c_rays(meta):
@@ -148,12 +164,45 @@ def sensor(ctx, meta, range_min=0.3, range_max=120.0, mounting=None):
                            shape=(meta["altitudes"].size, meta["columns"]), mounting=mounting)
 
 
+def window_mask(meta):
+    """Which measurement ids the frame measures: a bool array of columns,
+    True inside column_window [start, end] (inclusive; it wraps past the last
+    column when start > end)."""
+    meta = _meta(meta)
+    start, end = meta["column_window"]
+    v = np.arange(meta["columns"])
+    return (v >= start) & (v <= end) if start <= end else (v >= start) | (v <= end)
+
+
 def sensor_ranges(ranges, meta):
     """Ranges as the sensor reports them: the simulated distance from each beam
-    origin plus the beam offset (no return stays +inf, too near stays -inf)."""
-    b = _meta(meta)["beam_to_lidar"]
+    origin plus the beam offset (no return stays +inf, too near stays -inf),
+    and NaN in the columns outside the frame's column_window (no data there).
+    ranges: (..., beams, columns), as ctx.simulate returns them for sensor()."""
+    meta = _meta(meta)
+    b = meta["beam_to_lidar"]
     offset = math.hypot(b[0, 3], b[2, 3]) / 1000.0  # rc_ouster_rays' beam_offset_m, without making every ray
     r = np.array(ranges, dtype=np.float64, copy=True)
     finite = np.isfinite(r)
     r[finite] += offset
+    if r.ndim >= 2 and r.shape[-1] == meta["columns"]:
+        r[..., ~window_mask(meta)] = np.nan
     return r
+
+
+def destagger(field, meta):
+    """A field of a frame (..., beams, columns) in the sensor's measurement-id
+    order turned into an image whose columns share one azimuth, as Ouster's
+    SDK destaggers: out[..., u, (v + pixel_shift[u]) mod columns] = in[..., u, v].
+    ValueError when the metadata has no pixel_shift_by_row."""
+    meta = _meta(meta)
+    shift = meta["pixel_shift"]
+    if shift is None:
+        raise ValueError("ouster metadata: no pixel_shift_by_row to destagger with")
+    f = np.asarray(field)
+    if f.ndim < 2 or f.shape[-2:] != (shift.size, meta["columns"]):
+        raise ValueError("destagger: expected (..., %d, %d), got %s" % (shift.size, meta["columns"], f.shape))
+    out = np.empty_like(f)
+    for u in range(shift.size):
+        out[..., u, :] = np.roll(f[..., u, :], int(shift[u]), axis=-1)
+    return out

@@ -87,7 +87,11 @@ class OusterRays(unittest.TestCase):
         for broken, words in (({"lidar_mode": "1024x10"}, "beam_altitude_angles"),
                               (dict(LEGACY, beam_azimuth_angles=[0.0]), "same length"),
                               (dict(LEGACY, lidar_mode="unknown"), "columns_per_frame"),
-                              (dict(LEGACY, lidar_to_sensor_transform=[1, 0, 0]), "16 finite")):
+                              (dict(LEGACY, lidar_to_sensor_transform=[1, 0, 0]), "16 finite"),
+                              (dict(LEGACY, pixel_shift_by_row=[1, 2]), "one integer a beam"),
+                              (dict(LEGACY, pixel_shift_by_row=[1, 2, 3.5, 4]), "one integer a beam"),
+                              (dict(LEGACY, column_window=[0, 8]), "column_window"),
+                              (dict(LEGACY, column_window=[3]), "column_window")):
             with self.assertRaises(ValueError) as e:
                 ouster.read_metadata(broken)
             self.assertIn(words, str(e.exception))
@@ -115,6 +119,29 @@ class OusterRays(unittest.TestCase):
                 np.testing.assert_allclose(points.reshape(-1, 3)[k], origins[k] + want * dirs[k], atol=5e-5)
             reported = ouster.sensor_ranges(ranges, path)
             np.testing.assert_allclose(reported - ranges, 0.015806, atol=1e-6)
+
+
+    def test_frame_window_and_destagger(self):
+        meta = ouster.read_metadata(dict(NESTED, lidar_data_format={
+            "columns_per_frame": 8, "pixels_per_column": 4, "column_window": [6, 1],
+            "pixel_shift_by_row": [2, 0, -1, 9]}))
+        self.assertEqual(meta["column_window"], (6, 1))
+        np.testing.assert_array_equal(ouster.window_mask(meta), [True, True, False, False, False, False, True, True])
+        field = np.arange(2 * 4 * 8, dtype=np.float32).reshape(2, 4, 8)
+        out = ouster.destagger(field, meta)
+        for u, s in enumerate((2, 0, -1, 9)):
+            for v in range(8):  # out[u][(v + shift) mod 8] = in[u][v], as the SDK
+                self.assertEqual(out[1, u, (v + s) % 8], field[1, u, v])
+        r = ouster.sensor_ranges(np.full((4, 8), 10.0), meta)
+        self.assertTrue(np.all(np.isnan(r[:, 2:6])))
+        np.testing.assert_allclose(r[:, [0, 1, 6, 7]], 10.015806, atol=1e-9)
+        whole = ouster.read_metadata(NESTED)  # no window, no shifts
+        self.assertTrue(np.all(ouster.window_mask(whole)))
+        self.assertIsNone(whole["pixel_shift"])
+        with self.assertRaises(ValueError):
+            ouster.destagger(field, whole)
+        with self.assertRaises(ValueError):
+            ouster.destagger(field[:, :3], meta)
 
 
 if __name__ == "__main__":
