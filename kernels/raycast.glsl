@@ -62,7 +62,16 @@ layout(push_constant) uniform PC {
     uint groups_x;    /* workgroups per row of the 2D dispatch */
     uint flags;       /* bit 0: one mesh, no instances: skip the top level */
     uint off_hits, off_ranges, off_points, off_normals, off_prim, off_geom, off_inst;
+    /* range noise of results kept on the device (noise.glsl) */
+    uint noise_key_lo, noise_key_hi;   /* rc__noise_key(seed, draw) */
+    uint noise_drop_lo, noise_drop_hi; /* dropout when the 53 uniform bits are below this */
+    float noise_mean, noise_sigma, noise_exponent;
+    uint noise_flags;                  /* NOISE_* */
 } pc;
+
+#define NOISE_ON 1u
+#define NOISE_MOVES 2u
+#define NOISE_DROPS 4u
 
 /* ---- chunked loads ------------------------------------------------------ */
 
@@ -731,6 +740,62 @@ float refine_t(Hit h, vec3 org, vec3 dir)
 }
 #endif
 
+/* ---- noise (results kept on the device) -------------------------------------- */
+
+#include "noise.glsl"
+
+/* noise.c's noise_task for one return: element k's draws are uniforms 3k and
+ * 3k + 1 (the normal) and 3k + 2 (dropout). true when the return is lost;
+ * else range and pt moved along the ray (origin o, sensor frame) as move()
+ * moves them, in double where the device has it. */
+bool apply_noise(uvec2 k3, vec3 o, inout float range, inout vec3 pt)
+{
+    uvec2 key = uvec2(pc.noise_key_lo, pc.noise_key_hi);
+    if ((pc.noise_flags & NOISE_DROPS) != 0u) {
+        uvec2 m = noise_bits(key, add64(k3, uvec2(2u, 0u)));
+        if (m.y < pc.noise_drop_hi || (m.y == pc.noise_drop_hi && m.x < pc.noise_drop_lo)) return true;
+    }
+    if ((pc.noise_flags & NOISE_MOVES) == 0u || (ATTRS & (ATTR_RANGES | ATTR_POINTS)) == 0u) return false;
+    float z = noise_normal(key, k3);
+#if RC_FP64
+    double r;
+    if ((ATTRS & ATTR_RANGES) != 0u) {
+        r = double(range);
+    } else {
+        precise double dx = double(pt.x) - double(o.x);
+        precise double dy = double(pt.y) - double(o.y);
+        precise double dz = double(pt.z) - double(o.z);
+        r = sqrt(dx * dx + dy * dy + dz * dz);
+    }
+    double e = double(pc.noise_exponent);
+    double scale = e == 0.0lf ? 1.0lf : e == 1.0lf ? r : (r > 0.0lf ? exp_d(e * log_d(r)) : 0.0lf);
+    precise double spread = double(pc.noise_sigma) * scale * double(z);
+    if (isnan(spread)) spread = 0.0lf;
+    precise double moved = r + double(pc.noise_mean) + spread;
+    moved = max(moved, double(pc.range_min));
+    moved = min(moved, double(pc.range_max));
+    range = float(moved);
+    if (r > 0.0lf) {
+        precise double f = moved / r;
+        precise double px = double(o.x) + (double(pt.x) - double(o.x)) * f;
+        precise double py = double(o.y) + (double(pt.y) - double(o.y)) * f;
+        precise double pz = double(o.z) + (double(pt.z) - double(o.z)) * f;
+        pt = vec3(float(px), float(py), float(pz));
+    }
+#else
+    float r = (ATTRS & ATTR_RANGES) != 0u ? range : length(pt - o);
+    float e = pc.noise_exponent;
+    float scale = e == 0.0 ? 1.0 : e == 1.0 ? r : (r > 0.0 ? pow(r, e) : 0.0);
+    precise float spread = pc.noise_sigma * scale * z;
+    if (isnan(spread)) spread = 0.0;
+    precise float moved = r + pc.noise_mean + spread;
+    moved = clamp(moved, pc.range_min, pc.range_max);
+    range = moved;
+    if (r > 0.0) pt = o + (pt - o) * (moved / r);
+#endif
+    return false;
+}
+
 void main()
 {
     uint gid = (gl_WorkGroupID.y * pc.groups_x + gl_WorkGroupID.x) * gl_WorkGroupSize.x + gl_LocalInvocationID.x;
@@ -764,28 +829,35 @@ void main()
     bool valid = found && t >= pc.range_min && t <= pc.range_max;
     float range = valid ? t : (found && t < pc.range_min ? uintBitsToFloat(0xFF800000u) : uintBitsToFloat(0x7F800000u));
     const uint nan_bits = 0x7FC00000u;
+    vec3 pt = vec3(0.0);
+    if (valid) {
+        precise float px = ds.x * range;
+        precise float py = ds.y * range;
+        precise float pz = ds.z * range;
+        if (MODEL == MODEL_ONDN) {
+            px += os.x;
+            py += os.y;
+            pz += os.z;
+        }
+        pt = vec3(px, py, pz);
+    }
+    if ((pc.noise_flags & NOISE_ON) != 0u && valid && (ATTRS & ~ATTR_INST_IDS) != 0u) {
+        uint klo, khi;
+        umulExtended(pose, pc.rays, khi, klo);
+        uvec2 k3 = mul64(add64(uvec2(klo, khi), uvec2(ray, 0u)), uvec2(3u, 0u));
+        if (apply_noise(k3, MODEL == MODEL_ONDN ? os : vec3(0.0), range, pt)) {
+            valid = false;
+            range = uintBitsToFloat(0x7F800000u);
+        }
+    }
 
     if ((ATTRS & ATTR_HITS) != 0u) outb.o[pc.off_hits + gid] = valid ? 1u : 0u;
     if ((ATTRS & ATTR_RANGES) != 0u) outb.o[pc.off_ranges + gid] = floatBitsToUint(range);
     if ((ATTRS & ATTR_POINTS) != 0u) {
         uint o = pc.off_points + 3u * gid;
-        if (valid) {
-            precise float px = ds.x * range;
-            precise float py = ds.y * range;
-            precise float pz = ds.z * range;
-            if (MODEL == MODEL_ONDN) {
-                px += os.x;
-                py += os.y;
-                pz += os.z;
-            }
-            outb.o[o] = floatBitsToUint(px);
-            outb.o[o + 1u] = floatBitsToUint(py);
-            outb.o[o + 2u] = floatBitsToUint(pz);
-        } else {
-            outb.o[o] = nan_bits;
-            outb.o[o + 1u] = nan_bits;
-            outb.o[o + 2u] = nan_bits;
-        }
+        outb.o[o] = valid ? floatBitsToUint(pt.x) : nan_bits;
+        outb.o[o + 1u] = valid ? floatBitsToUint(pt.y) : nan_bits;
+        outb.o[o + 2u] = valid ? floatBitsToUint(pt.z) : nan_bits;
     }
     if ((ATTRS & ATTR_NORMALS) != 0u) {
         uint o = pc.off_normals + 3u * gid;

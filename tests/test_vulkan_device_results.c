@@ -2,8 +2,14 @@
  * exposed VkBuffer through its own Vulkan calls on the exposed device and
  * finds, bit for bit, what rc_simulate writes to host buffers; the buffer's
  * description goes stale at the next simulate; too large a batch is a
- * capacity error, not a device fault. */
+ * capacity error, not a device fault. With noise on the sensor the kernel
+ * applies it there: the same returns lost as the host's pass, the same
+ * spread within float rounding (float64 kernel) or within GLSL's loose
+ * log/cos (float-only kernel). */
+#define _POSIX_C_SOURCE 200809L
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include <vulkan/vulkan.h>
@@ -198,8 +204,144 @@ static void test_device_results_match_host(void **state)
     rcu_mesh_free(&box);
 }
 
+/* One noisy batch, on the host and on the device, from two sensors with the
+ * same noise (so both use draw `calls - 1` on their last call): hit flags
+ * (dropout) equal, ranges and points within tol (metres, plus 1e-6
+ * relative). *moved counts returns whose range (or, without ranges, point)
+ * the noise changed; returns how many of those ranges were bit-identical. */
+static uint64_t compare_noisy(rc_context *ctx, rc_scene *scene, const rc_noise_desc *noise, uint32_t attributes,
+                              const rc_pose *poses, uint32_t pose_count, uint32_t calls, double tol, uint64_t *moved)
+{
+    rc_sensor *hs, *ds, *clean;
+    rct_buffers host, ref;
+    rc_results dev = rc_results_default();
+    rc_device_results dr = rc_device_results_default();
+    readback rb;
+    const unsigned char *base;
+    const uint64_t n = (uint64_t)pose_count * 16u * 900u;
+    uint64_t k, same = 0;
+    uint32_t c, words = 0, a;
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &hs));
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &ds));
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &clean));
+    RCT_OK(ctx, rc_sensor_set_noise(hs, noise));
+    RCT_OK(ctx, rc_sensor_set_noise(ds, noise));
+    rct_buffers_alloc(&host, n, RC_ATTR_ALL);
+    rct_buffers_alloc(&ref, n, RC_ATTR_ALL);
+    host.res.attributes = attributes;
+    dev.attributes = attributes;
+    dev.flags = RC_RESULTS_ON_DEVICE;
+    /* the clean scan first: a host simulate makes the device results stale */
+    RCT_OK(ctx, rc_simulate(ctx, scene, clean, poses, pose_count, &ref.res));
+    for (c = 0; c < calls; ++c) {
+        RCT_OK(ctx, rc_simulate(ctx, scene, hs, poses, pose_count, &host.res));
+        RCT_OK(ctx, rc_simulate(ctx, scene, ds, poses, pose_count, &dev));
+    }
+    RCT_OK(ctx, rc_context_get_device_results(ctx, &dr));
+    for (a = 0; a < 7; ++a) words += (attributes >> a) & 1u ? (a == 2 || a == 3 ? 3u : 1u) : 0u;
+    assert_true(dr.bytes == n * words * 4u);
+    read_device_buffer(&dr, &rb);
+    base = (const unsigned char *)rb.map;
+    *moved = 0;
+    for (k = 0; k < n; ++k) {
+        if (attributes & RC_ATTR_HITS) {
+            uint32_t h;
+            memcpy(&h, base + dr.offsets[0] + 4u * k, 4);
+            if (h != host.res.hits[k]) fail_msg("element %llu: hit %u on the device, %u on the host",
+                                                (unsigned long long)k, h, host.res.hits[k]);
+        }
+        if (attributes & RC_ATTR_RANGES) {
+            float r;
+            const float want = host.res.ranges[k];
+            memcpy(&r, base + dr.offsets[1] + 4u * k, 4);
+            if (isinf(want) || isinf(r)) {
+                if (memcmp(&r, &want, 4) != 0)
+                    fail_msg("element %llu: range %g on the device, %g on the host", (unsigned long long)k, (double)r,
+                             (double)want);
+            } else if (fabs((double)r - (double)want) > tol + 1e-6 * fabs((double)want)) {
+                fail_msg("element %llu: range %.9g on the device, %.9g on the host", (unsigned long long)k, (double)r,
+                         (double)want);
+            }
+            if (isfinite(want) && want != ref.res.ranges[k]) {
+                ++*moved;
+                same += memcmp(&r, &want, 4) == 0;
+            }
+        }
+        if (attributes & RC_ATTR_POINTS) {
+            float p[3];
+            uint32_t i;
+            memcpy(p, base + dr.offsets[2] + 12u * k, 12);
+            for (i = 0; i < 3; ++i) {
+                const float want = host.res.points[3u * k + i];
+                if (isnan(want) != isnan(p[i]) ||
+                    (!isnan(want) && fabs((double)p[i] - (double)want) > tol + 1e-6 * (fabs((double)want) + 1.0)))
+                    fail_msg("element %llu: point[%u] %.9g on the device, %.9g on the host", (unsigned long long)k, i,
+                             (double)p[i], (double)want);
+            }
+            if (!(attributes & RC_ATTR_RANGES))
+                *moved += !isnan(host.res.points[3u * k]) && host.res.points[3u * k] != ref.res.points[3u * k];
+        }
+    }
+    readback_free(&rb);
+    rct_buffers_free(&host);
+    rct_buffers_free(&ref);
+    rc_sensor_destroy(hs);
+    rc_sensor_destroy(ds);
+    rc_sensor_destroy(clean);
+    return same;
+}
+
+static void test_device_noise_matches_host(void **state)
+{
+    rcu_mesh m;
+    rc_pose poses[3];
+    rc_noise_desc flat = rc_noise_desc_default(), grow = rc_noise_desc_default();
+    int fp64_kernel;
+    (void)state;
+    NEED_VULKAN();
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 60, 30, &m), 0);
+    poses[0] = rct_pose(5.0f, 0.0f, 0.0f);
+    poses[1] = rct_pose_ypr(-6.0f, 3.0f, 0.5f, 0.7, 0.1, -0.2);
+    poses[2] = rct_pose_ypr(0.0f, 8.0f, -2.0f, -2.0, -0.3, 0.05);
+    flat.mean = 0.01f;
+    flat.sigma = 0.03f;
+    flat.dropout = 0.25f;
+    flat.seed = 1234;
+    grow.sigma = 0.002f;
+    grow.sigma_exponent = 1.7f; /* pow on the device */
+    grow.seed = 99;
+    for (fp64_kernel = 1; fp64_kernel >= 0; --fp64_kernel) {
+        /* the float-only kernel: GLSL's log and cos (cos within 2^-11 absolute) */
+        const double tol = fp64_kernel ? 0.0 : 0.01 * 0.03;
+        rc_context *ctx;
+        rc_scene *scene;
+        uint64_t moved = 0, n = 3u * 16u * 900u, same;
+        if (!fp64_kernel) setenv("RANGECAST_VULKAN_NO_FP64", "1", 1);
+        ctx = rct_context(RC_BACKEND_VULKAN, 2, 0);
+        if (!fp64_kernel) unsetenv("RANGECAST_VULKAN_NO_FP64");
+        scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+        /* every attribute, the second call's draw */
+        same = compare_noisy(ctx, scene, &flat, RC_ATTR_ALL, poses, 3, 2, tol, &moved);
+        print_message("%s kernel, constant noise and dropout: %llu of %llu moved ranges bit-identical\n",
+                      fp64_kernel ? "float64" : "float-only", (unsigned long long)same, (unsigned long long)moved);
+        assert_true(moved > n / 2u); /* the noise is there: 3/4 of the returns kept, all of them moved */
+        if (fp64_kernel) assert_true(same * 100u >= moved * 99u);
+        /* points only (the range comes from the point), noise growing with range */
+        (void)compare_noisy(ctx, scene, &grow, RC_ATTR_POINTS | RC_ATTR_HITS, poses, 3, 1, tol, &moved);
+        assert_true(moved > n / 2u);
+        /* dropout alone, hits alone: the same returns lost */
+        flat.sigma = flat.mean = 0.0f;
+        (void)compare_noisy(ctx, scene, &flat, RC_ATTR_HITS, poses, 3, 1, 0.0, &moved);
+        flat.sigma = 0.03f;
+        flat.mean = 0.01f;
+        rc_context_destroy(ctx);
+    }
+    rcu_mesh_free(&m);
+}
+
 int main(void)
 {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(test_device_results_match_host)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(test_device_results_match_host),
+                                       cmocka_unit_test(test_device_noise_matches_host)};
     return cmocka_run_group_tests_name("vulkan device results", tests, NULL, NULL);
 }

@@ -699,8 +699,12 @@ RC_API rc_status rc_sensor_set_mounting(rc_sensor *sensor, const rc_pose *sensor
  * and backend; each call gets fresh noise. Returns are told apart by the
  * requested attributes (hits, ranges, points, normals, prim or geom ids): a
  * request of inst_ids alone is left as traced. Results kept on the device
- * (RC_RESULTS_ON_DEVICE) cannot have noise: simulate returns
- * RC_ERR_UNSUPPORTED. */
+ * (RC_RESULTS_ON_DEVICE) get the same noise from the Vulkan kernel: the same
+ * returns lost, and ranges and points equal to the host's where the device
+ * has shaderFloat64 (the kernel computes Box-Muller's log and cos in double;
+ * lavapipe gave them to the bit), within GLSL's looser log and cos without
+ * it (cos is bounded only to 2^-11 absolute: 0.3% of sigma). Such a call
+ * uses a draw like any other. */
 typedef struct rc_noise_desc {
     uint32_t struct_size;
     uint32_t reserved0;

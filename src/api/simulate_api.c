@@ -64,9 +64,6 @@ static rc_status simulate(rc_context *ctx, const rc_scene *scene, const rc_senso
                  "results->flags has RC_RESULTS_ON_DEVICE, but the context's backend (%s) has no device: "
                  "results can only go to host buffers",
                  ctx->backend->name);
-    RC_RETURN_IF(ctx, (results->flags & RC_RESULTS_ON_DEVICE) && sensor->noise.enabled, RC_ERR_UNSUPPORTED,
-                 "results->flags has RC_RESULTS_ON_DEVICE, but the sensor has noise (rc_sensor_set_noise), "
-                 "which is applied to host buffers only");
     a = results->attributes;
     RC_RETURN_IF(ctx, a == 0, RC_ERR_INVALID_ARGUMENT, "results->attributes is 0: request at least one RC_ATTR_*");
     RC_RETURN_IF(ctx, (a & ~RC_ATTR_ALL) != 0, RC_ERR_INVALID_ARGUMENT,
@@ -105,8 +102,17 @@ poses_check:
     job.attributes = a;
     job.out = results;
     job.flags = results->flags;
+    job.noise = NULL;
+    job.noise_key = 0;
+    if (sensor->noise.enabled && (results->flags & RC_RESULTS_ON_DEVICE)) {
+        /* no host buffers to pass over: the backend applies it on the device */
+        job.noise = &sensor->noise;
+        job.noise_key = rc__noise_key(sensor->noise.seed, sensor->noise.draws);
+    }
     RC_TRY(ctx->backend->simulate(ctx, &job));
-    if (sensor->noise.enabled) {
+    if (job.noise) {
+        ((rc_sensor *)sensor)->noise.draws++;
+    } else if (sensor->noise.enabled) {
         rc__noise_job nj;
         nj.out = results;
         nj.attributes = a;

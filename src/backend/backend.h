@@ -19,6 +19,11 @@ typedef struct rc__sim_job {
     uint32_t attributes;       /* RC_ATTR_* */
     const rc_results *out;
     uint32_t flags;            /* RC_RESULTS_* (ON_DEVICE only where device_results is set) */
+    /* results on the device: the sensor's noise (NULL: none) for the backend
+     * to apply there, draw key rc__noise_key(seed, draws). Host results get
+     * the host's pass after simulate instead, whatever the backend. */
+    const struct rc__noise *noise;
+    uint64_t noise_key;
 } rc__sim_job;
 
 typedef struct rc__backend {

@@ -36,14 +36,23 @@ typedef struct rc__vk_xform {
     uint32_t d[24];
 } rc__vk_xform;
 
-/* Push constants of raycast.comp (GLSL: uniform PC), 20 words. */
+/* Push constants of raycast.comp (GLSL: uniform PC), 28 words. */
 typedef struct rc__vk_push {
     uint32_t first_pose, first_ray, count, rays;
     uint32_t columns, rows;
     float range_min, range_max;
     uint32_t geom_count, top_node, top_ref, groups_x, flags;
     uint32_t off[7]; /* word offsets of hits, ranges, points, normals, prim, geom, inst */
+    /* range noise of results kept on the device (kernels/noise.glsl) */
+    uint32_t noise_key[2];  /* rc__noise_key(seed, draw), low word first */
+    uint32_t noise_drop[2]; /* floor(dropout * 2^53): a return is lost below it */
+    float noise_mean, noise_sigma, noise_exponent;
+    uint32_t noise_flags;   /* RC__VK_NOISE_* */
 } rc__vk_push;
+
+#define RC__VK_NOISE_ON 1u
+#define RC__VK_NOISE_MOVES 2u
+#define RC__VK_NOISE_DROPS 4u
 
 #define RC__VK_ASSERT(cond, name) typedef char rc__vk_layout_assert_##name[(cond) ? 1 : -1]
 
@@ -62,7 +71,9 @@ RC__VK_ASSERT(sizeof(double) == 8, double_size);
 RC__VK_ASSERT(offsetof(rc__vk_inst, n2w) == 48, inst_n2w);
 RC__VK_ASSERT(offsetof(rc__vk_inst, first_geom) == 96, inst_first_geom);
 RC__VK_ASSERT(offsetof(rc__vk_inst, geom_count) == 100, inst_geom_count);
-RC__VK_ASSERT(sizeof(rc__vk_push) == 80, push_size);
+RC__VK_ASSERT(sizeof(rc__vk_push) == 112, push_size);
+RC__VK_ASSERT(offsetof(rc__vk_push, noise_key) == 80, push_noise_key);
+RC__VK_ASSERT(offsetof(rc__vk_push, noise_flags) == 108, push_noise_flags);
 RC__VK_ASSERT(offsetof(rc__vk_push, range_min) == 24, push_range_min);
 RC__VK_ASSERT(offsetof(rc__vk_push, off) == 52, push_off);
 

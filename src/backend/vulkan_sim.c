@@ -14,6 +14,9 @@
  * narrowed to bytes). */
 #include "backend/vulkan_internal.h"
 
+#include "noise/noise.h"
+
+#include <math.h>
 #include <string.h>
 
 static void layout_binding(VkDescriptorSetLayoutBinding *b, uint32_t binding, VkDescriptorType type)
@@ -310,6 +313,24 @@ static rc_status record_dispatch(rc__vk_state *st, uint32_t slot, VkPipeline pip
     return rc__vk_submit(st, slot);
 }
 
+/* The noise words of the push constants (kernels/noise.glsl). */
+static void noise_push(const rc__sim_job *job, rc__vk_push *push)
+{
+    const rc__noise *nz = job->noise;
+    /* a return is lost when its uniform (m + 1) / 2^53 <= dropout, i.e. when
+     * m < floor(dropout * 2^53) (exact: a power-of-two scale of a float) */
+    const uint64_t drop = (uint64_t)floor((double)nz->dropout * 9007199254740992.0);
+    push->noise_key[0] = (uint32_t)job->noise_key;
+    push->noise_key[1] = (uint32_t)(job->noise_key >> 32);
+    push->noise_drop[0] = (uint32_t)drop;
+    push->noise_drop[1] = (uint32_t)(drop >> 32);
+    push->noise_mean = nz->mean;
+    push->noise_sigma = nz->sigma;
+    push->noise_exponent = nz->exponent;
+    push->noise_flags = RC__VK_NOISE_ON | (nz->mean != 0.0f || nz->sigma != 0.0f ? RC__VK_NOISE_MOVES : 0u) |
+                        (nz->dropout > 0.0f ? RC__VK_NOISE_DROPS : 0u);
+}
+
 static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
 {
     const rc_sensor *sensor = job->sensor;
@@ -427,6 +448,7 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         push.flags = sv->info.flags;
         push.groups_x = groups < lim->maxComputeWorkGroupCount[0] ? groups : lim->maxComputeWorkGroupCount[0];
         groups_y = (groups + push.groups_x - 1u) / push.groups_x;
+        if (job->noise) noise_push(job, &push);
         if (on_device) { /* this dispatch's elements of the batch-wide arrays */
             for (a = 0; a < 7; ++a) push.off[a] = dev_off[a] + (uint32_t)first * attr_words[a];
         } else {

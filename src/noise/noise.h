@@ -1,12 +1,14 @@
 /* Range noise and dropout (rc_sensor_set_noise): one pass over the host
  * results after the backend traced them, so every backend and thread count
- * gets the same numbers from the same counter-based generator. */
+ * gets the same numbers from the same counter-based generator. Results kept
+ * on the device get the same generator in the Vulkan kernel
+ * (kernels/noise.glsl, keep the two in step). */
 #ifndef RC_NOISE_NOISE_H
 #define RC_NOISE_NOISE_H
 
 #include "core/context.h"
 
-typedef struct rc__noise {
+typedef struct rc__noise { /* struct tag: backend.h forward-declares it */
     int enabled;          /* 0: simulate skips the pass */
     float mean, sigma, exponent, dropout;
     uint64_t seed;
