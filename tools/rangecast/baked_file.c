@@ -19,6 +19,8 @@
 static struct {
     const float *vertices; /* the copy's vertex array: identifies the mesh */
     rcp_baked baked;
+    uint64_t *first_triangle; /* geometry g's triangles start here in the copy (geoms + 1 entries) */
+    uint32_t geoms;
 } maps[MAX_MAPS];
 static unsigned map_count;
 
@@ -64,41 +66,73 @@ static const char *header_problem(const rcp_baked *b, rc_status st)
     return text;
 }
 
+/* Copies geometry g of b into out after what out holds (vertex indices
+ * offset by it; out has the room). */
+static void append_geometry(const rc_mesh_desc *md, rcu_mesh *out)
+{
+    const uint64_t v0 = out->vertex_count, t0 = out->triangle_count;
+    uint64_t i;
+    for (i = 0; i < md->vertex_count; ++i) /* 16-byte vertices to packed xyz */
+        memcpy(out->vertices + 3u * (size_t)(v0 + i), md->vertices + 4u * (size_t)i, 3 * sizeof(float));
+    for (i = 0; i < 3u * md->triangle_count; ++i) out->indices[3u * t0 + i] = md->indices[i] + (uint32_t)v0;
+    out->vertex_count = (uint32_t)(v0 + md->vertex_count);
+    out->triangle_count = (uint32_t)(t0 + md->triangle_count);
+}
+
 int rcp_baked_load_mesh(const char *path, rcu_mesh *out)
 {
     rcp_baked b;
     rc_mesh_desc md = rc_mesh_desc_default();
-    uint32_t geoms = 0;
-    uint64_t i;
+    uint32_t geoms = 0, g;
+    uint64_t *first = NULL, vertices = 0, triangles = 0;
     rc_status st;
     memset(out, 0, sizeof *out);
     if (map_count == MAX_MAPS) return rcu_fail("%s: more than %d baked maps open", path, MAX_MAPS);
     if (map_file(path, &b) != 0) return -1;
     st = rc_baked_get_mesh(b.blob, b.bytes, 0, &md, &geoms);
-    if (st == RC_OK && geoms != 1) {
-        /* the commands read a map as one mesh: their float64 reference finds
-         * a hit's triangle by its prim id alone */
-        rcu_fail("%s holds %u geometries; this program reads baked maps of one mesh, as 'rangecast bake' "
-                 "writes them (load others with rc_scene_load_baked)",
-                 path, (unsigned)geoms);
-    } else if (st != RC_OK) {
+    for (g = 0; st == RC_OK && g < geoms; ++g) /* the sizes first: one copy holds them all */
+        if ((st = rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL)) == RC_OK) {
+            vertices += md.vertex_count;
+            triangles += md.triangle_count;
+        }
+    if (st != RC_OK) {
         rcu_fail("%s: %s; bake it again with 'rangecast bake'", path, header_problem(&b, st));
-    } else if (rcu_mesh_reserve(out, md.vertex_count, md.triangle_count) != 0) {
-        rcu_fail("%s: out of memory copying its triangles", path);
-    } else {
-        for (i = 0; i < md.vertex_count; ++i) /* 16-byte vertices to packed xyz */
-            memcpy(out->vertices + 3u * (size_t)i, md.vertices + 4u * (size_t)i, 3 * sizeof(float));
-        memcpy(out->indices, md.indices, (size_t)md.triangle_count * 3u * sizeof(uint32_t));
-        out->vertex_count = (uint32_t)md.vertex_count;
-        out->triangle_count = (uint32_t)md.triangle_count;
+    } else if (!(first = (uint64_t *)malloc(sizeof *first * ((size_t)geoms + 1u)))) {
+        rcu_fail("%s: out of memory for %u geometry records", path, (unsigned)geoms);
+    } else if (rcu_mesh_reserve(out, vertices, triangles) == 0) {
+        /* the geometries one after another in one copy: the commands' float64
+         * reference finds a hit's triangle at first[geom id] + prim id */
+        for (g = 0; g < geoms; ++g) {
+            first[g] = out->triangle_count;
+            (void)rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL); /* read above: cannot fail */
+            append_geometry(&md, out);
+        }
+        first[geoms] = out->triangle_count;
         maps[map_count].vertices = out->vertices;
         maps[map_count].baked = b;
+        maps[map_count].first_triangle = first;
+        maps[map_count].geoms = geoms;
         map_count++;
         return 0;
+    } else {
+        rcu_fail("%s: %s", path, rcu_last_error());
     }
+    free(first);
     rcu_mesh_free(out);
     munmap((void *)(uintptr_t)b.blob, b.bytes);
     return -1;
+}
+
+uint64_t rcp_mesh_triangle(const rcu_mesh *mesh, uint32_t geom, uint32_t prim)
+{
+    unsigned k;
+    for (k = 0; mesh && mesh->vertices && k < map_count; ++k)
+        if (maps[k].vertices == mesh->vertices) {
+            if (geom >= maps[k].geoms || prim >= maps[k].first_triangle[geom + 1u] - maps[k].first_triangle[geom])
+                return UINT64_MAX;
+            return maps[k].first_triangle[geom] + prim;
+        }
+    return geom == 0 && mesh && prim < mesh->triangle_count ? prim : UINT64_MAX;
 }
 
 const rcp_baked *rcp_baked_of(const rcu_mesh *mesh)

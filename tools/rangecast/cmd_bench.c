@@ -381,7 +381,7 @@ int rcp_cmd_bench(int argc, char **argv)
     rcu_preset_rays ref;
     float *ranges = NULL, *cranges = NULL;
     uint8_t *chits = NULL;
-    uint32_t *cprims = NULL;
+    uint32_t *cprims = NULL, *cgeoms = NULL;
     double *rep_s = NULL, median_s, scans_per_s, sphere_in = 0.0;
     uint64_t peak_rss;
     uint32_t last_batch_start;
@@ -522,7 +522,8 @@ int rcp_cmd_bench(int argc, char **argv)
     cranges = (float *)malloc((size_t)chunk * rays * sizeof(float));
     chits = (uint8_t *)malloc((size_t)chunk * rays);
     cprims = (uint32_t *)malloc((size_t)chunk * rays * sizeof(uint32_t));
-    if (!cranges || !chits || !cprims) {
+    cgeoms = (uint32_t *)malloc((size_t)chunk * rays * sizeof(uint32_t));
+    if (!cranges || !chits || !cprims || !cgeoms) {
         rcp_fail(cmd, "out of memory for the accuracy pass");
         goto done;
     }
@@ -535,10 +536,12 @@ int rcp_cmd_bench(int argc, char **argv)
         rc_results res = rc_results_default();
         rcu_xform mount;
         rcu_xform_from_pose(&ref.mount, &mount);
-        res.attributes = RC_ATTR_RANGES | RC_ATTR_HITS | RC_ATTR_PRIM_IDS;
+        /* (geom id, prim id) name the hit triangle: a baked map may hold several meshes */
+        res.attributes = RC_ATTR_RANGES | RC_ATTR_HITS | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS;
         res.ranges = cranges;
         res.hits = chits;
         res.prim_ids = cprims;
+        res.geom_ids = cgeoms;
         res.capacity = (uint64_t)chunk * rays;
         for (p = 0; p < pose_count; p += chunk) {
             uint32_t n = pose_count - p < chunk ? pose_count - p : chunk, s, r;
@@ -563,7 +566,7 @@ int rcp_cmd_bench(int argc, char **argv)
                 rcu_xform pose, x;
                 const float *rr = cranges + (size_t)s * rays;
                 const uint8_t *hh = chits + (size_t)s * rays;
-                const uint32_t *pp = cprims + (size_t)s * rays;
+                const uint32_t *pp = cprims + (size_t)s * rays, *gg = cgeoms + (size_t)s * rays;
                 /* the timed loop's last batch is still in `ranges`: the same
                  * poses must give the same bits with a different attribute mask */
                 if (pose_index >= last_batch_start &&
@@ -584,10 +587,11 @@ int rcp_cmd_bench(int argc, char **argv)
                     }
                     if (hit) {
                         acc.hits++;
-                        if (pp[r] >= mesh.triangle_count) {
+                        const uint64_t tri = rcp_mesh_triangle(&mesh, gg[r], pp[r]);
+                        if (tri >= mesh.triangle_count) {
                             acc.bad_prims++;
                         } else {
-                            const uint32_t *t = mesh.indices + 3u * (size_t)pp[r];
+                            const uint32_t *t = mesh.indices + 3u * (size_t)tri;
                             double tr = rcu_ray_plane_distance(o, d, mesh.vertices + 3u * (size_t)t[0],
                                                                mesh.vertices + 3u * (size_t)t[1],
                                                                mesh.vertices + 3u * (size_t)t[2]);
@@ -633,7 +637,7 @@ int rcp_cmd_bench(int argc, char **argv)
                 (unsigned long long)acc.bad_prims);
     if (acc.differing)
         fprintf(stderr, "rangecast bench: warning: %llu scans give different ranges with "
-                        "RANGES|HITS|PRIM_IDS than with RANGES alone\n", (unsigned long long)acc.differing);
+                        "RANGES|HITS|PRIM_IDS|GEOM_IDS than with RANGES alone\n", (unsigned long long)acc.differing);
 
     /* ---- the JSON line ---- */
     {
@@ -702,6 +706,7 @@ done:
     free(cranges);
     free(chits);
     free(cprims);
+    free(cgeoms);
     free(ranges);
     free(rep_s);
     free(poses);
