@@ -1,7 +1,8 @@
 /* The Vulkan backend's own contracts: the C/GLSL layout (read back on the
  * device), the packed arrays (a C traversal of them finds exactly what the
  * scene's own traversal finds), device choice, memory figures and arena
- * accounting, binding limits, the sensor cache, device loss. */
+ * accounting, binding limits, the sensor cache, device loss, and commits
+ * that only moved instances rewriting only the instances and the top level. */
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <stdio.h>
@@ -456,11 +457,18 @@ static void test_no_driver(void **state)
     d.memory_size = (size_t)1 << 20;
     d.log = capture_log;
     g_log[0] = '\0';
-    setenv("VK_ICD_FILENAMES", "/nonexistent/rangecast_icd.json", 1);
-    setenv("VK_DRIVER_FILES", "/nonexistent/rangecast_icd.json", 1);
-    st = rc_context_create(&d, &ctx);
-    unsetenv("VK_ICD_FILENAMES");
-    unsetenv("VK_DRIVER_FILES");
+    {
+        /* the test's own driver choice (the ray query runs set one) comes back after */
+        const char *was = getenv("VK_ICD_FILENAMES");
+        char *keep = was ? strdup(was) : NULL;
+        setenv("VK_ICD_FILENAMES", "/nonexistent/rangecast_icd.json", 1);
+        setenv("VK_DRIVER_FILES", "/nonexistent/rangecast_icd.json", 1);
+        st = rc_context_create(&d, &ctx);
+        if (keep) setenv("VK_ICD_FILENAMES", keep, 1);
+        else unsetenv("VK_ICD_FILENAMES");
+        unsetenv("VK_DRIVER_FILES");
+        free(keep);
+    }
     print_message("%s", g_log);
     assert_int_equal(st, RC_ERR_UNSUPPORTED);
     assert_null(ctx);
@@ -468,6 +476,159 @@ static void test_no_driver(void **state)
 }
 
 /* Result names for the messages. */
+/* A dynamic map on the device: a static sphere (the map) and three instanced
+ * boxes moved between scans. A commit that only moved instances rewrites
+ * their records and the top level in place (no new device memory), and the
+ * scans match the built-in backend's after every move; adding an instance or
+ * changing a source's mesh uploads everything again. Mapped and staged uploads
+ * (RANGECAST_VULKAN_STAGING), so both ways of writing the top are covered. */
+typedef struct dyn_world {
+    rc_context *ctx;
+    rc_scene *box, *world;
+    rc_sensor *lidar;
+    rcu_mesh box_mesh;
+} dyn_world;
+
+static void dyn_make(dyn_world *w, uint32_t backend, const rcu_mesh *sphere)
+{
+    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t id, i;
+    memset(w, 0, sizeof *w);
+    assert_int_equal(rcu_mesh_box(lo, hi, &w->box_mesh), 0);
+    w->ctx = rct_context(backend, 2, 0);
+    w->box = rct_scene_mesh(w->ctx, &w->box_mesh, RC_MESH_REFERENCE);
+    sd.max_geometries = 1;
+    sd.max_instances = 4;
+    sd.max_triangles = sphere->triangle_count;
+    RCT_OK(w->ctx, rc_scene_create(w->ctx, &sd, &w->world));
+    md.vertices = sphere->vertices;
+    md.vertex_count = sphere->vertex_count;
+    md.indices = sphere->indices;
+    md.triangle_count = sphere->triangle_count;
+    RCT_OK(w->ctx, rc_scene_add_mesh(w->world, &md, &id));
+    for (i = 0; i < 3; ++i) {
+        rc_instance_desc in = rc_instance_desc_default();
+        in.source = w->box;
+        in.transform = rct_pose(3.0f * (float)i - 3.0f, 2.0f, 0.0f);
+        RCT_OK(w->ctx, rc_scene_add_instance(w->world, &in, &id));
+    }
+    RCT_OK(w->ctx, rc_scene_commit(w->world));
+    RCT_OK(w->ctx, rc_sensor_create_preset(w->ctx, RC_PRESET_VELODYNE_VLP16, &w->lidar));
+}
+
+static void dyn_move(dyn_world *w, uint32_t step)
+{
+    uint32_t i;
+    for (i = 0; i < 3; ++i) {
+        const rc_pose p = rct_pose_ypr(3.0f * (float)i - 3.0f + 0.5f * (float)step, 2.0f - 0.3f * (float)step,
+                                       0.2f * (float)i, 0.4 * step + i, 0.1 * i, 0.0);
+        const float scale[3] = {1.0f + 0.1f * (float)step, 1.0f, 2.0f};
+        RCT_OK(w->ctx, rc_scene_set_instance_transform(w->world, i, &p, scale));
+    }
+    RCT_OK(w->ctx, rc_scene_commit(w->world));
+}
+
+static void dyn_scan(dyn_world *w, rct_buffers *b)
+{
+    const rc_pose pose = rct_pose_ypr(0.5f, -0.5f, 0.2f, 0.3, 0.0, 0.0);
+    RCT_OK(w->ctx, rc_simulate(w->ctx, w->world, w->lidar, &pose, 1, &b->res));
+}
+
+static void dyn_free(dyn_world *w)
+{
+    rc_context_destroy(w->ctx);
+    rcu_mesh_free(&w->box_mesh);
+}
+
+/* hits and ids equal, ranges within 1e-5 (relative) */
+static void dyn_compare(const rct_buffers *a, const rct_buffers *b, uint64_t n)
+{
+    uint64_t k, boxes = 0;
+    for (k = 0; k < n; ++k) {
+        assert_int_equal(a->res.hits[k], b->res.hits[k]);
+        if (!a->res.hits[k]) continue;
+        if (fabsf(a->res.ranges[k] - b->res.ranges[k]) > 1e-5f * b->res.ranges[k])
+            fail_msg("element %llu: %.9g on Vulkan, %.9g on the built-in backend", (unsigned long long)k,
+                     (double)a->res.ranges[k], (double)b->res.ranges[k]);
+        assert_int_equal(a->res.inst_ids[k], b->res.inst_ids[k]);
+        boxes += a->res.inst_ids[k] != RC_INVALID_ID;
+    }
+    assert_true(boxes > 50u); /* the moved boxes are in view */
+}
+
+/* The same move on Vulkan and on the built-in backend, then both scans compared. */
+static void dyn_step(dyn_world *v, dyn_world *c, uint32_t step, rct_buffers *bv, rct_buffers *bc, uint64_t n)
+{
+    dyn_move(v, step);
+    dyn_move(c, step);
+    dyn_scan(v, bv);
+    dyn_scan(c, bc);
+    dyn_compare(bv, bc, n);
+}
+
+static void test_dynamic_commit_rewrites_only_the_top(void **state)
+{
+    rcu_mesh sphere;
+    int staged;
+    const uint64_t n = 16u * 900u;
+    (void)state;
+    NEED_VULKAN();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, rct_quick() ? 5000u : 50000u, &sphere), 0);
+    for (staged = 0; staged <= 1; ++staged) {
+        dyn_world v, c;
+        rct_buffers bv, bc;
+        rc_memory_stats m0 = rc_memory_stats_default(), m1 = rc_memory_stats_default();
+        uint32_t full = 0, top = 0, step;
+        if (staged) setenv("RANGECAST_VULKAN_STAGING", "1", 1);
+        dyn_make(&v, RC_BACKEND_VULKAN, &sphere);
+        unsetenv("RANGECAST_VULKAN_STAGING");
+        dyn_make(&c, RC_BACKEND_BVH, &sphere);
+        rct_buffers_alloc(&bv, n, RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_INST_IDS);
+        rct_buffers_alloc(&bc, n, RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_INST_IDS);
+        for (step = 1; step <= 4; ++step) {
+            dyn_step(&v, &c, step, &bv, &bc, n);
+            /* after the first scan (which sets up the per-call buffers) */
+            if (step == 1) RCT_OK(v.ctx, rc_context_get_memory_stats(v.ctx, &m0));
+        }
+        rc__vk_debug_scene_uploads(v.world, &full, &top);
+        assert_int_equal(full, 1);
+        assert_int_equal(top, 4);
+        RCT_OK(v.ctx, rc_context_get_memory_stats(v.ctx, &m1));
+        assert_true(m1.device_bytes == m0.device_bytes); /* the same buffers, rewritten */
+        /* a source's mesh changed (and re-committed): everything again */
+        v.box_mesh.vertices[0] += 0.25f;
+        c.box_mesh.vertices[0] += 0.25f;
+        RCT_OK(v.ctx, rc_scene_update_mesh(v.box, 0));
+        RCT_OK(c.ctx, rc_scene_update_mesh(c.box, 0));
+        RCT_OK(v.ctx, rc_scene_commit(v.box));
+        RCT_OK(c.ctx, rc_scene_commit(c.box));
+        dyn_step(&v, &c, 5, &bv, &bc, n);
+        rc__vk_debug_scene_uploads(v.world, &full, &top);
+        assert_int_equal(full, 2);
+        /* one more instance: the layout changes, the next commit uploads */
+        {
+            rc_instance_desc in = rc_instance_desc_default();
+            uint32_t id;
+            in.source = v.box;
+            in.transform = rct_pose(0.0f, -4.0f, 0.0f);
+            RCT_OK(v.ctx, rc_scene_add_instance(v.world, &in, &id));
+            in.source = c.box;
+            RCT_OK(c.ctx, rc_scene_add_instance(c.world, &in, &id));
+        }
+        dyn_step(&v, &c, 6, &bv, &bc, n);
+        rc__vk_debug_scene_uploads(v.world, &full, &top);
+        assert_int_equal(full, 3); /* a new instance: the layout changed */
+        assert_int_equal(top, 4);
+        rct_buffers_free(&bv);
+        rct_buffers_free(&bc);
+        dyn_free(&v);
+        dyn_free(&c);
+    }
+    rcu_mesh_free(&sphere);
+}
+
 static void test_result_names(void **state)
 {
     (void)state;
@@ -485,6 +646,7 @@ int main(void)
         cmocka_unit_test(test_binding_limits),
         cmocka_unit_test(test_sensor_cache),    cmocka_unit_test(test_device_lost),
         cmocka_unit_test(test_no_driver),
+        cmocka_unit_test(test_dynamic_commit_rewrites_only_the_top),
     };
     return cmocka_run_group_tests_name("vulkan backend", tests, NULL, NULL);
 }

@@ -262,25 +262,50 @@ static rc_status build_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv)
     return s;
 }
 
-rc_status rc__vk_accel_build(rc_scene *scene, uint32_t serial)
+/* Numbers the bottom levels: the own meshes' (when the scene has any) 0,
+ * then each source in packing order (serial tags them for this commit).
+ * Returns how many there are. */
+static uint32_t number_sources(rc_scene *scene, uint32_t serial)
 {
-    rc__vk_state *st = rc__vk(scene->ctx);
-    rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
-    const uint32_t own = scene->geom_count > 0 ? 1u : 0u;
-    uint32_t n = own, i;
-    rc_status s = RC_OK;
-    rc__vk_accel_release(st, sv);
-    RC_RETURN_IF(scene->ctx, scene->inst_count > MAX_INSTANCES, RC_ERR_UNSUPPORTED,
-                 "vulkan: the ray query traversal takes at most %u instances a scene (24-bit custom indices); "
-                 "this one has %u",
-                 (unsigned)MAX_INSTANCES, (unsigned)scene->inst_count);
-    /* number the sources in packing order (serial tags them for this commit) */
+    uint32_t n = scene->geom_count > 0 ? 1u : 0u, i;
     for (i = 0; i < scene->inst_count; ++i) {
         rc__vk_scene *src = (rc__vk_scene *)scene->insts[i].source->backend_scene;
         if (src->accel_serial == serial) continue;
         src->accel_serial = serial;
         src->pack_blas = n++;
     }
+    return n;
+}
+
+rc_status rc__vk_accel_update_top(rc_scene *scene, uint32_t serial)
+{
+    rc__vk_state *st = rc__vk(scene->ctx);
+    rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
+    rc_status s;
+    if (number_sources(scene, serial) != sv->blas_count || sv->blas_count == 0) {
+        /* not the bottom levels of these sources: build them all, tagged afresh */
+        if (++st->serial == 0) ++st->serial;
+        return rc__vk_accel_build(scene, st->serial);
+    }
+    accel_destroy(st, &sv->tlas);
+    s = build_top(st, scene, sv);
+    if (s != RC_OK) rc__vk_accel_release(st, sv);
+    return s;
+}
+
+rc_status rc__vk_accel_build(rc_scene *scene, uint32_t serial)
+{
+    rc__vk_state *st = rc__vk(scene->ctx);
+    rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
+    const uint32_t own = scene->geom_count > 0 ? 1u : 0u;
+    uint32_t n, i;
+    rc_status s = RC_OK;
+    rc__vk_accel_release(st, sv);
+    RC_RETURN_IF(scene->ctx, scene->inst_count > MAX_INSTANCES, RC_ERR_UNSUPPORTED,
+                 "vulkan: the ray query traversal takes at most %u instances a scene (24-bit custom indices); "
+                 "this one has %u",
+                 (unsigned)MAX_INSTANCES, (unsigned)scene->inst_count);
+    n = number_sources(scene, serial);
     sv->blas = (rc__vk_accel *)rc__vk_host_alloc(st, (size_t)n * sizeof *sv->blas);
     RC_RETURN_IF(scene->ctx, sv->blas == NULL, RC_ERR_OUT_OF_MEMORY,
                  "vulkan: no host memory for %u acceleration structure records", (unsigned)n);

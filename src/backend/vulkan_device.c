@@ -527,11 +527,17 @@ void rc__vk_barrier(rc__vk_state *st, VkCommandBuffer cb, VkPipelineStageFlags s
 rc_status rc__vk_copy(rc__vk_state *st, const rc__vk_buffer *src, const rc__vk_buffer *dst, VkDeviceSize src_off,
                       VkDeviceSize size)
 {
+    return rc__vk_copy_region(st, src, dst, src_off, 0, size);
+}
+
+rc_status rc__vk_copy_region(rc__vk_state *st, const rc__vk_buffer *src, const rc__vk_buffer *dst,
+                             VkDeviceSize src_off, VkDeviceSize dst_off, VkDeviceSize size)
+{
     VkBufferCopy region;
     RC_TRY(rc__vk_buffer_flush(st, src));
     RC_TRY(rc__vk_begin(st, 0));
     region.srcOffset = src_off;
-    region.dstOffset = 0;
+    region.dstOffset = dst_off;
     region.size = size;
     vkCmdCopyBuffer(st->cmd[0], src->buf, dst->buf, 1, &region);
     rc__vk_barrier(st, st->cmd[0], VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,

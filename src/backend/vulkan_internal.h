@@ -83,7 +83,13 @@ typedef struct rc__vk_scene {
     uint32_t blas_count;
     uint32_t pack_blas;
     uint32_t accel_serial;
-    uint32_t reserved0;
+    /* 1 when the device arrays hold the scene as of its last successful
+     * commit (0 from the start of a commit until it succeeds): a commit that
+     * only moved instances then rewrites only their records and the top
+     * level (vulkan_scene.c) */
+    uint32_t current;
+    uint32_t up_geoms, up_insts;  /* geometries and instances the device arrays hold */
+    uint32_t full_uploads, top_updates; /* commits of each kind (test hook) */
 } rc__vk_scene;
 
 typedef struct rc__vk_pipeline {
@@ -210,6 +216,9 @@ rc_status rc__vk_buffer_invalidate(rc__vk_state *st, const rc__vk_buffer *b);
 /* Records, submits and waits for copies src -> dst (regions). */
 rc_status rc__vk_copy(rc__vk_state *st, const rc__vk_buffer *src, const rc__vk_buffer *dst, VkDeviceSize src_off,
                       VkDeviceSize size);
+/* The same into dst at dst_off. */
+rc_status rc__vk_copy_region(rc__vk_state *st, const rc__vk_buffer *src, const rc__vk_buffer *dst,
+                             VkDeviceSize src_off, VkDeviceSize dst_off, VkDeviceSize size);
 /* Command slots (command buffer + fence): wait for one (no-op when idle),
  * begin recording into it (waits first), submit it. */
 rc_status rc__vk_wait(rc__vk_state *st, uint32_t slot);
@@ -232,6 +241,9 @@ const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
 void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info);
 /* Writes them (after rc__vk_pack_count with the same serial). */
 void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
+/* Writes only what a commit that moved instances changes: the instance
+ * records and the top level's nodes and refs (after rc__vk_pack_count). */
+void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
 
 /* Host copy of packed arrays (linear, one chunk each). */
 typedef struct rc__vk_packed {
@@ -259,6 +271,8 @@ size_t rc__vk_scene_commit_bytes(const rc_scene_desc *desc);
 /* Builds the scene's driver acceleration structures from its packed meshes
  * (after rc__vk_pack_count with serial tagged the instance sources). */
 rc_status rc__vk_accel_build(rc_scene *scene, uint32_t serial);
+/* Rebuilds only the top level over the same bottom levels (instances moved). */
+rc_status rc__vk_accel_update_top(rc_scene *scene, uint32_t serial);
 void rc__vk_accel_release(rc__vk_state *st, rc__vk_scene *sv);
 
 /* vulkan_sensor.c --------------------------------------------------------- */
@@ -282,6 +296,9 @@ rc_status rc__vk_device_results(rc_context *ctx, rc_device_results *out);
 rc_status rc__vk_layout_check(rc_context *ctx);
 /* Test hook: behave as if the device had been lost. */
 void rc__vk_debug_mark_lost(rc_context *ctx);
+/* Test hook: how many commits of the scene uploaded everything and how many
+ * only rewrote the instances and the top level. */
+void rc__vk_debug_scene_uploads(const rc_scene *scene, uint32_t *full, uint32_t *top);
 /* Test hook: the device name and whether the float64 kernel runs. */
 const char *rc__vk_device_name(const rc_context *ctx, int *fp64, uint32_t *chunks);
 

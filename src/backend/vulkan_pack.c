@@ -123,6 +123,30 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst
     c->geom += 1u;
 }
 
+/* Instance i's record: its transforms and where its source's meshes are
+ * (sources tagged by rc__vk_pack_count). */
+static void instance_record(const rc__instance *in, rc__vk_inst *entry)
+{
+    const rc__vk_scene *sv = vk_scene_of(in->source);
+    double d[12];
+    int r;
+    memset(entry, 0, sizeof *entry);
+    for (r = 0; r < 3; ++r) {
+        entry->to_local[4 * r + 0] = in->to_local.r[3 * r + 0];
+        entry->to_local[4 * r + 1] = in->to_local.r[3 * r + 1];
+        entry->to_local[4 * r + 2] = in->to_local.r[3 * r + 2];
+        entry->to_local[4 * r + 3] = in->to_local.t[r];
+        entry->n2w[4 * r + 0] = in->normal_to_world[3 * r + 0];
+        entry->n2w[4 * r + 1] = in->normal_to_world[3 * r + 1];
+        entry->n2w[4 * r + 2] = in->normal_to_world[3 * r + 2];
+    }
+    memcpy(d, in->to_world.rd, 9 * sizeof(double));
+    memcpy(d + 9, in->to_world.td, 3 * sizeof(double));
+    memcpy(entry->to_world_d, d, sizeof entry->to_world_d);
+    entry->first_geom = sv->pack_first_geom;
+    entry->geom_count = in->source->geom_count;
+}
+
 void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst)
 {
     pack_cursor c;
@@ -132,35 +156,25 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
     for (i = 0; i < scene->inst_count; ++i) {
         const rc__instance *in = &scene->insts[i];
         rc__vk_scene *sv = vk_scene_of(in->source);
-        rc__vk_inst entry;
-        int r;
         if (sv->fill_serial != serial) { /* first use of this source: its meshes go here */
             sv->fill_serial = serial;
             for (g = 0; g < in->source->geom_count; ++g) fill_mesh(&in->source->geoms[g].mesh, g, dst, &c);
         }
-        memset(&entry, 0, sizeof entry);
-        for (r = 0; r < 3; ++r) {
-            entry.to_local[4 * r + 0] = in->to_local.r[3 * r + 0];
-            entry.to_local[4 * r + 1] = in->to_local.r[3 * r + 1];
-            entry.to_local[4 * r + 2] = in->to_local.r[3 * r + 2];
-            entry.to_local[4 * r + 3] = in->to_local.t[r];
-            entry.n2w[4 * r + 0] = in->normal_to_world[3 * r + 0];
-            entry.n2w[4 * r + 1] = in->normal_to_world[3 * r + 1];
-            entry.n2w[4 * r + 2] = in->normal_to_world[3 * r + 2];
-        }
-        {
-            double d[12];
-            memcpy(d, in->to_world.rd, 9 * sizeof(double));
-            memcpy(d + 9, in->to_world.td, 3 * sizeof(double));
-            memcpy(entry.to_world_d, d, sizeof entry.to_world_d);
-        }
-        entry.first_geom = sv->pack_first_geom;
-        entry.geom_count = in->source->geom_count;
-        span_write(&dst->insts, i, &entry, 1);
     }
     if (c.node < info->top_node) {
         static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
         span_write(&dst->nodes, c.node, &pad, 1);
+    }
+    rc__vk_pack_fill_top(scene, info, dst);
+}
+
+void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst)
+{
+    uint32_t i;
+    for (i = 0; i < scene->inst_count; ++i) {
+        rc__vk_inst entry;
+        instance_record(&scene->insts[i], &entry);
+        span_write(&dst->insts, i, &entry, 1);
     }
     span_write(&dst->nodes, info->top_node, scene->top.nodes, scene->top.node_count);
     span_write(&dst->refs, info->top_ref, scene->top.refs, scene->top.item_count);

@@ -11,6 +11,10 @@
  * checked before allocating so it never reaches the driver's limits.
  * With the ray query traversal the commit also builds the driver's
  * acceleration structures (vulkan_accel.c).
+ * A commit after moving instances only (a dynamic map: a large static map
+ * and a few moving objects) keeps the buffers and rewrites the instance
+ * records and the top level in place, and rebuilds only the top-level
+ * acceleration structure: its cost is the instances', not the map's.
  * Arena use: the rc__vk_scene record plus the BVH (rc__scene_bvh_commit_bytes). */
 #include "backend/vulkan_internal.h"
 
@@ -89,6 +93,101 @@ static void span_of(const array_plan *a, const rc__vk_buffer *staging, rc__vk_sp
         s->chunk[c] = staging ? (unsigned char *)staging->map + a->staging_off[c] : (unsigned char *)a->bufs[c].map;
 }
 
+/* 1 when the device arrays hold this scene's meshes as they are now, laid out
+ * as they will be: the last commit succeeded, no mesh was added, updated or
+ * re-committed in a source since, and no instance was added. Read before the
+ * build, which clears the meshes' dirty marks. */
+static int meshes_unchanged(const rc_scene *scene, const rc__vk_scene *sv)
+{
+    uint32_t i;
+    if (!sv->current || sv->up_geoms != scene->geom_count || sv->up_insts != scene->inst_count) return 0;
+    for (i = 0; i < scene->geom_count; ++i)
+        if (scene->geoms[i].dirty) return 0;
+    for (i = 0; i < scene->inst_count; ++i)
+        if (scene->insts[i].source->version != scene->source_versions[i]) return 0;
+    return 1;
+}
+
+/* A span over one device array's buffers (mapped, or a staging map). */
+static rc__vk_span span_over(const rc__vk_buffer *bufs, uint32_t chunks, uint32_t shift, uint32_t elem_size)
+{
+    rc__vk_span sp;
+    uint32_t c;
+    memset(&sp, 0, sizeof sp);
+    sp.shift = shift;
+    sp.elem_size = elem_size;
+    for (c = 0; c < chunks; ++c) sp.chunk[c] = (unsigned char *)bufs[c].map;
+    return sp;
+}
+
+/* Copies count elements of a chunked device array from staging (at src_off)
+ * to element first on, chunk by chunk. */
+static rc_status copy_chunked(rc__vk_state *st, const rc__vk_buffer *staging, VkDeviceSize src_off,
+                              const rc__vk_buffer *bufs, uint32_t shift, uint32_t elem_size, uint64_t first,
+                              uint64_t count)
+{
+    const uint64_t per = (uint64_t)1 << shift;
+    while (count) {
+        const uint64_t c = first >> shift, off = first & (per - 1u), n = count < per - off ? count : per - off;
+        RC_TRY(rc__vk_copy_region(st, staging, &bufs[c], src_off, off * elem_size, n * elem_size));
+        src_off += n * elem_size;
+        first += n;
+        count -= n;
+    }
+    return RC_OK;
+}
+
+/* The commit of a scene whose meshes did not change: the instance records
+ * and the top level rewritten in place, the rest of the device arrays (and,
+ * for ray query, the bottom levels) kept. *done 0 when the packed layout
+ * differs after all (the caller uploads everything). */
+static rc_status update_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv, int *done)
+{
+    rc__vk_pack_info info;
+    rc__vk_pack_dst dst;
+    rc__vk_buffer staging;
+    const uint64_t inst_bytes = (uint64_t)scene->inst_count * sizeof(rc__vk_inst);
+    const uint64_t node_bytes = (uint64_t)scene->top.node_count * sizeof(rc__bvh_node);
+    const uint64_t ref_bytes = (uint64_t)scene->top.item_count * 4u;
+    uint32_t serial, c;
+    rc_status s = RC_OK;
+    *done = 0;
+    if (++st->serial == 0) ++st->serial;
+    serial = st->serial;
+    rc__vk_pack_count(scene, serial, &info);
+    if (memcmp(&info, &sv->info, sizeof info) != 0) return RC_OK;
+    *done = 1;
+    memset(&dst, 0, sizeof dst);
+    if (st->device_mappable) {
+        dst.nodes = span_over(sv->nodes, sv->node_chunks, st->node_shift, (uint32_t)sizeof(rc__bvh_node));
+        dst.refs = span_over(&sv->refs, 1, 31u, 4u);
+        dst.insts = span_over(&sv->insts, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
+        rc__vk_pack_fill_top(scene, &info, &dst);
+        for (c = 0; c < sv->node_chunks && s == RC_OK; ++c) s = rc__vk_buffer_flush(st, &sv->nodes[c]);
+        if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->refs);
+        if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->insts);
+    } else {
+        /* staged: records, nodes and refs one after another, then copied */
+        const uint64_t node_off = (inst_bytes + 31u) & ~(uint64_t)31u, ref_off = node_off + node_bytes;
+        RC_TRY(rc__vk_buffer_create(st, ref_off + ref_bytes, RC__VK_MEM_UPLOAD, "upload staging", &staging));
+        dst.insts = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
+        dst.nodes = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__bvh_node));
+        dst.refs = span_over(&staging, 1, 31u, 4u);
+        /* the top level at the start of its staging section, not at its index */
+        info.top_node = (uint32_t)(node_off / sizeof(rc__bvh_node));
+        info.top_ref = (uint32_t)(ref_off / 4u);
+        rc__vk_pack_fill_top(scene, &info, &dst);
+        if (inst_bytes) s = rc__vk_copy_region(st, &staging, &sv->insts, 0, 0, inst_bytes);
+        if (s == RC_OK)
+            s = copy_chunked(st, &staging, node_off, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node),
+                             sv->info.top_node, scene->top.node_count);
+        if (s == RC_OK) s = rc__vk_copy_region(st, &staging, &sv->refs, ref_off, (uint64_t)sv->info.top_ref * 4u, ref_bytes);
+        rc__vk_buffer_destroy(st, &staging);
+    }
+    if (s == RC_OK && st->ray_query) s = rc__vk_accel_update_top(scene, serial);
+    return s;
+}
+
 rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user)
 {
     rc_context *ctx = scene->ctx;
@@ -111,7 +210,24 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
                      (unsigned long long)rc__arena_largest_free(&ctx->arena));
         scene->backend_scene = sv;
     }
-    RC_TRY(rc__scene_build_bvh(scene, progress, user));
+    {
+        const int unchanged = meshes_unchanged(scene, sv);
+        int done = 0;
+        sv->current = 0; /* until this commit succeeds */
+        RC_TRY(rc__scene_build_bvh(scene, progress, user));
+        if (unchanged) {
+            s = update_top(st, scene, sv, &done);
+            if (s != RC_OK) {
+                release_buffers(st, sv);
+                return s;
+            }
+            if (done) {
+                sv->top_updates++;
+                sv->current = 1;
+                return RC_OK;
+            }
+        }
+    }
     release_buffers(st, sv);
 
     if (++st->serial == 0) ++st->serial;
@@ -197,6 +313,10 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
     if (s == RC_OK && st->ray_query) s = rc__vk_accel_build(scene, serial);
     if (s != RC_OK) goto fail;
     sv->info = info;
+    sv->up_geoms = scene->geom_count;
+    sv->up_insts = scene->inst_count;
+    sv->full_uploads++;
+    sv->current = 1;
     return RC_OK;
 fail:
     release_buffers(st, sv);
