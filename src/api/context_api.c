@@ -89,11 +89,13 @@ static rc_status resolve_desc(const rc_context_desc *desc, const rc__backend **b
             return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->reserved[%u] is %u; reserved words must be 0",
                             (unsigned)i, (unsigned)desc->reserved[i]);
     if (desc->flags & ~RC_CONTEXT_VULKAN_RAY_QUERY)
-        return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->flags is 0x%x; only RC_CONTEXT_VULKAN_RAY_QUERY (0x%x) is defined",
+        return why_fail(why, RC_ERR_INVALID_ARGUMENT,
+                        "desc->flags is 0x%x; only RC_CONTEXT_VULKAN_RAY_QUERY (0x%x) is defined",
                         (unsigned)desc->flags, RC_CONTEXT_VULKAN_RAY_QUERY);
     if ((desc->flags & RC_CONTEXT_VULKAN_RAY_QUERY) && desc->backend != RC_BACKEND_VULKAN)
         return why_fail(why, RC_ERR_INVALID_ARGUMENT,
-                        "desc->flags has RC_CONTEXT_VULKAN_RAY_QUERY, which needs desc->backend RC_BACKEND_VULKAN (it is %s)",
+                        "desc->flags has RC_CONTEXT_VULKAN_RAY_QUERY, which needs desc->backend "
+                        "RC_BACKEND_VULKAN (it is %s)",
                         rc_backend_name(desc->backend));
     if (desc->backend > RC_BACKEND_VULKAN)
         return why_fail(why, RC_ERR_INVALID_ARGUMENT, "desc->backend is %u; not an RC_BACKEND_* value",

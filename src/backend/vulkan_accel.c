@@ -11,9 +11,9 @@
  * them) are written (a, a, a), as in the packed arrays. (The spec's way to
  * switch a triangle off, a vertex with a NaN coordinate, made lavapipe 25.0's
  * builder lose whole subtrees: 2,463 of the stability suite's 2,668
- * degenerate-case rays wrong, against 1 with (a, a, a).) Top level: one instance for the own meshes
- * (custom index 0) and one per rangecast instance (custom index = id + 1,
- * transform = source to scene, scale included).
+ * degenerate-case rays wrong, against 1 with (a, a, a).) Top level: one
+ * instance for the own meshes (custom index 0) and one per rangecast instance
+ * (custom index = id + 1, transform = source to scene, scale included).
  *
  * The build inputs live in host-visible buffers for the build only; the
  * structures stay in device memory, counted with the backend's buffers and
@@ -55,7 +55,7 @@ static rc_status accel_build(rc__vk_state *st, VkAccelerationStructureTypeKHR ty
                              const char *what, rc__vk_accel *out)
 {
     VkAccelerationStructureBuildGeometryInfoKHR build;
-    VkAccelerationStructureBuildGeometryInfoKHR *info = &build;
+    const VkAccelerationStructureBuildGeometryInfoKHR *info = &build;
     VkAccelerationStructureBuildSizesInfoKHR sizes;
     VkAccelerationStructureCreateInfoKHR ci;
     VkAccelerationStructureDeviceAddressInfoKHR ai;
@@ -80,7 +80,7 @@ static rc_status accel_build(rc__vk_state *st, VkAccelerationStructureTypeKHR ty
     ci.sType = VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR;
     ci.buffer = out->storage.buf;
     ci.size = sizes.accelerationStructureSize;
-    ci.type = info->type;
+    ci.type = type;
     r = st->create_as(st->device, &ci, RC__VK_OBJ_ALLOC, &out->as);
     if (r != VK_SUCCESS) {
         out->as = VK_NULL_HANDLE;
@@ -96,9 +96,9 @@ static rc_status accel_build(rc__vk_state *st, VkAccelerationStructureTypeKHR ty
     }
     at = rc__vk_buffer_address(st, &scratch);
     at = (at + st->scratch_align - 1u) / st->scratch_align * st->scratch_align;
-    info->mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
-    info->dstAccelerationStructure = out->as;
-    info->scratchData.deviceAddress = at;
+    build.mode = VK_BUILD_ACCELERATION_STRUCTURE_MODE_BUILD_KHR;
+    build.dstAccelerationStructure = out->as;
+    build.scratchData.deviceAddress = at;
     s = rc__vk_begin(st, 0);
     if (s == RC_OK) {
         st->build_as(st->cmd[0], 1, info, &ranges);
@@ -148,7 +148,8 @@ static void fill_input(const rc__mesh *m, unsigned char *dst)
     for (i = 0; i < m->vertex_count; ++i) memcpy(v + 3u * i, m->vertices + (size_t)i * m->stride, 3 * sizeof(float));
     for (i = 0; i < m->triangle_count; ++i) {
         const uint32_t *t = m->indices + (size_t)3u * m->bvh.refs[i];
-        const int flat = rc__tri_zero_area(m->vertices + (size_t)t[0] * m->stride, m->vertices + (size_t)t[1] * m->stride,
+        const int flat = rc__tri_zero_area(m->vertices + (size_t)t[0] * m->stride,
+                                           m->vertices + (size_t)t[1] * m->stride,
                                            m->vertices + (size_t)t[2] * m->stride);
         idx[3u * i] = t[0];
         idx[3u * i + 1u] = flat ? t[0] : t[1];

@@ -373,8 +373,8 @@ rc_status rc__vk_buffer_create_usage(rc__vk_state *st, VkDeviceSize size, uint32
     memset(&bi, 0, sizeof bi);
     bi.sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO;
     bi.size = size;
-    bi.usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
-               usage;
+    bi.usage =
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT | usage;
     bi.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
     r = vkCreateBuffer(st->device, &bi, RC__VK_OBJ_ALLOC, &out->buf);
     if (r != VK_SUCCESS) {
@@ -696,7 +696,8 @@ static rc_status ray_query_support(rc__vk_state *st)
     p2.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2;
     p2.pNext = &ap;
     vkGetPhysicalDeviceProperties2(st->phys, &p2);
-    st->scratch_align = ap.minAccelerationStructureScratchOffsetAlignment ? ap.minAccelerationStructureScratchOffsetAlignment : 1u;
+    st->scratch_align = ap.minAccelerationStructureScratchOffsetAlignment;
+    if (st->scratch_align == 0) st->scratch_align = 1;
     return RC_OK;
 }
 

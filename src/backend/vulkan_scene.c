@@ -181,7 +181,9 @@ static rc_status update_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv,
         if (s == RC_OK)
             s = copy_chunked(st, &staging, node_off, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node),
                              sv->info.top_node, scene->top.node_count);
-        if (s == RC_OK) s = rc__vk_copy_region(st, &staging, &sv->refs, ref_off, (uint64_t)sv->info.top_ref * 4u, ref_bytes);
+        if (s == RC_OK && ref_bytes) /* a copy of 0 bytes is not valid Vulkan */
+            s = rc__vk_copy_region(st, &staging, &sv->refs, ref_off, (uint64_t)sv->info.top_ref * 4u,
+                                   ref_bytes);
         rc__vk_buffer_destroy(st, &staging);
     }
     if (s == RC_OK && st->ray_query) s = rc__vk_accel_update_top(scene, serial);

@@ -32,6 +32,7 @@ void rcu_ouster_destagger(const float *in, float *out, uint32_t rows, uint32_t c
         /* shift mod columns, as a non-negative offset (shifts may be negative) */
         const int64_t s = ((int64_t)shift[u] % (int64_t)columns + (int64_t)columns) % (int64_t)columns;
         for (v = 0; v < columns; ++v)
-            out[(uint64_t)u * columns + (uint32_t)(((int64_t)v + s) % (int64_t)columns)] = in[(uint64_t)u * columns + v];
+            out[(uint64_t)u * columns + (uint32_t)(((int64_t)v + s) % (int64_t)columns)] =
+                in[(uint64_t)u * columns + v];
     }
 }
