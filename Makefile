@@ -42,7 +42,9 @@ demo: deps-demo
 test-fast: build
 	cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
+# (configured again: deps-test may have just unpacked the ray query tests' driver)
 test: deps-test
+	$(CMAKE) -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release $(CMAKE_FLAGS) >/dev/null
 	$(MAKE) test-fast
 	$(MAKE) asan
 

@@ -3,7 +3,8 @@
  * frame with its pose's transform, finds the nearest hit in the scene's
  * two-level BVH (the canonical layout of src/bvh/bvh.h, uploaded as is) and
  * writes the requested attributes with the CPU backend's exact semantics
- * (src/backend/results.c).
+ * (src/backend/results.c); for results kept on the device it also applies
+ * the sensor's range noise (noise.glsl), which host results get on the host.
  *
  * This is a port of src/scene/scene_trace.c, src/bvh/mesh.c and
  * src/bvh/intersect.h; keep them in step. Every expression whose rounding

@@ -96,7 +96,8 @@ static const char *frame_of(const cJSON *root, rcp_rays *out)
         if (!v) return "pixel_shift_by_row must be one integer a beam";
         out->pixel_shift = (int32_t *)malloc(sizeof(int32_t) * n);
         for (u = 0; out->pixel_shift && u < n; ++u) {
-            if (v[u] != (double)(int32_t)v[u] || v[u] < -65536.0 || v[u] > 65536.0) {
+            /* the range first: casting a double out of int32_t's range is undefined */
+            if (!(v[u] >= -65536.0 && v[u] <= 65536.0) || v[u] != (double)(int32_t)v[u]) {
                 free(v);
                 return "pixel_shift_by_row must be one integer a beam";
             }
