@@ -262,6 +262,9 @@ EOF
     sed 's/\[1, -1\]/[1]/' window.json >short_shift.json
     run 1 "pixel_shift_by_row must be one integer a beam" "$RC" simulate --map sphere.ply --pose 0,0,0 \
         -o s.pcd --sensor ouster:short_shift.json
+    sed 's/\[1, -1\]/[1e300, 2]/' window.json >huge_shift.json
+    run 1 "pixel_shift_by_row must be one integer a beam" "$RC" simulate --map sphere.ply --pose 0,0,0 \
+        -o s.pcd --sensor ouster:huge_shift.json
     sed 's/\[3, 0\]/[3, 4]/' window.json >wide_window.json
     run 1 "column_window must be two column indices" "$RC" simulate --map sphere.ply --pose 0,0,0 \
         -o w.pcd --sensor ouster:wide_window.json
