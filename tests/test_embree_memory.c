@@ -2,8 +2,9 @@
  * rc_memory_stats.backend_bytes, zero-copy sharing of mesh arrays, the budget
  * (public, rc_context_desc.backend_budget_mib, and internal, to the byte):
  * RC_ERR_OUT_OF_MEMORY, a scene that stays uncommitted and commits once the
- * budget allows; the exact arena figures, and Embree
- * errors turned into status codes with Embree's message. */
+ * budget allows; the exact arena figures, Embree errors turned into status
+ * codes with Embree's message, and a dynamic map's commit after moving
+ * instances rebuilding the instances' level only (the map's tree kept). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -285,6 +286,86 @@ static void test_error_mapping(void **state)
     rcu_mesh_free(&m);
 }
 
+/* A dynamic map: a 100k-triangle sphere with three instanced boxes. Moving
+ * the boxes and committing must not rebuild Embree's tree over the sphere
+ * (its meshes sit in their own Embree scene, embree_impl.h): what Embree
+ * allocates for that commit is a small fraction of what a rebuild of the
+ * sphere (after rc_scene_update_mesh) allocates. The scans after each commit
+ * match the built-in backend's. */
+static void test_moving_instances_keeps_the_map(void **state)
+{
+    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
+    rcu_mesh sphere, box;
+    rc_context *ctx[2];
+    rc_scene *src[2], *world[2];
+    rc_sensor *lidar[2];
+    rct_buffers out[2];
+    uint64_t before, moved, rebuilt;
+    uint32_t b, i, id, k, n = 16u * 900u;
+    (void)state;
+    NEED_EMBREE();
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000u, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    for (b = 0; b < 2; ++b) {
+        rc_scene_desc sd = rc_scene_desc_default();
+        rc_mesh_desc md = rc_mesh_desc_default();
+        ctx[b] = rct_context(b == 0 ? RC_BACKEND_EMBREE : RC_BACKEND_BVH, 2, 0);
+        src[b] = rct_scene_mesh(ctx[b], &box, RC_MESH_REFERENCE);
+        sd.max_geometries = 1;
+        sd.max_instances = 3;
+        sd.max_triangles = sphere.triangle_count;
+        RCT_OK(ctx[b], rc_scene_create(ctx[b], &sd, &world[b]));
+        md.vertices = sphere.vertices;
+        md.vertex_count = sphere.vertex_count;
+        md.indices = sphere.indices;
+        md.triangle_count = sphere.triangle_count;
+        RCT_OK(ctx[b], rc_scene_add_mesh(world[b], &md, &id));
+        for (i = 0; i < 3; ++i) {
+            rc_instance_desc in = rc_instance_desc_default();
+            in.source = src[b];
+            in.transform = rct_pose(3.0f * (float)i - 3.0f, 2.0f, 0.0f);
+            RCT_OK(ctx[b], rc_scene_add_instance(world[b], &in, &id));
+        }
+        RCT_OK(ctx[b], rc_scene_commit(world[b]));
+        RCT_OK(ctx[b], rc_sensor_create_preset(ctx[b], RC_PRESET_VELODYNE_VLP16, &lidar[b]));
+        rct_buffers_alloc(&out[b], n, RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_INST_IDS);
+    }
+    before = rc__embree_options_of(ctx[0])->bytes_allocated;
+    for (b = 0; b < 2; ++b) {
+        const rc_pose pose = rct_pose_ypr(0.5f, -0.5f, 0.2f, 0.3, 0.0, 0.0);
+        for (i = 0; i < 3; ++i) {
+            const rc_pose p = rct_pose_ypr(3.0f * (float)i - 2.0f, 1.0f, 0.3f, 0.5 + i, 0.1, 0.0);
+            RCT_OK(ctx[b], rc_scene_set_instance_transform(world[b], i, &p, NULL));
+        }
+        RCT_OK(ctx[b], rc_scene_commit(world[b]));
+        RCT_OK(ctx[b], rc_simulate(ctx[b], world[b], lidar[b], &pose, 1, &out[b].res));
+    }
+    moved = rc__embree_options_of(ctx[0])->bytes_allocated - before;
+    for (k = 0, i = 0; k < n; ++k) {
+        assert_int_equal(out[0].res.hits[k], out[1].res.hits[k]);
+        if (!out[0].res.hits[k]) continue;
+        assert_true(fabsf(out[0].res.ranges[k] - out[1].res.ranges[k]) <= 1e-5f * out[1].res.ranges[k]);
+        assert_int_equal(out[0].res.inst_ids[k], out[1].res.inst_ids[k]);
+        i += out[0].res.inst_ids[k] != RC_INVALID_ID;
+    }
+    assert_true(i > 50u); /* the moved boxes are in view */
+    /* the sphere's vertices updated: its tree is rebuilt */
+    before = rc__embree_options_of(ctx[0])->bytes_allocated;
+    RCT_OK(ctx[0], rc_scene_update_mesh(world[0], 0));
+    RCT_OK(ctx[0], rc_scene_commit(world[0]));
+    rebuilt = rc__embree_options_of(ctx[0])->bytes_allocated - before;
+    print_message("Embree allocated %llu bytes for a commit after moving instances, %llu after updating the map\n",
+                  (unsigned long long)moved, (unsigned long long)rebuilt);
+    assert_true(rebuilt > 1000000u);
+    assert_true(moved * 20u < rebuilt);
+    for (b = 0; b < 2; ++b) {
+        rct_buffers_free(&out[b]);
+        rc_context_destroy(ctx[b]);
+    }
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -293,6 +374,7 @@ int main(void)
         cmocka_unit_test(test_public_budget),
         cmocka_unit_test(test_arena_exact),
         cmocka_unit_test(test_error_mapping),
+        cmocka_unit_test(test_moving_instances_keeps_the_map),
     };
     return cmocka_run_group_tests_name("embree memory and errors", tests, NULL, NULL);
 }

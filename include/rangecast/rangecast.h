@@ -395,9 +395,10 @@ RC_API rc_instance_desc rc_instance_desc_default(void);
  * instance's frame starts where Embree no longer traces it.) */
 RC_API rc_status rc_scene_add_instance(rc_scene *scene, const rc_instance_desc *desc, uint32_t *inst_id);
 /* Moves an instance (dynamic maps); takes effect at the next commit, which only
- * rebuilds the top level (on Vulkan it also rewrites only the instances and
- * the top level on the device, when no mesh changed). The transform and
- * scale are checked as in rc_scene_add_instance. */
+ * rebuilds the top level when no mesh changed: Embree's tree over the scene's
+ * own meshes is kept, and Vulkan rewrites only the instances and the top
+ * level on the device. The transform and scale are checked as in
+ * rc_scene_add_instance. */
 RC_API rc_status rc_scene_set_instance_transform(rc_scene *scene, uint32_t inst_id,
                                                  const rc_pose *transform, const float scale[3]);
 

@@ -108,7 +108,10 @@ static bool on_memory(void *user, ssize_t bytes, bool post)
         atomic_max(&d->options.bytes_peak, now);
         return false;
     }
-    if (bytes > 0) atomic_max(&d->options.bytes_peak, now);
+    if (bytes > 0) {
+        atomic_max(&d->options.bytes_peak, now);
+        atomic_add(&d->options.bytes_allocated, (uint64_t)bytes); /* told before or after, once */
+    }
     return true;
 }
 

@@ -81,14 +81,29 @@ typedef struct rc__emb_geom {
 } rc__emb_geom;
 
 /* A scene's Embree state (scene->backend_scene), one arena block taken at the
- * first commit: geometries keep their ids, instance i has id max_geoms + i. */
+ * first commit: geometries keep their ids, instance i has id max_geoms + i.
+ * A scene that can hold instances (a dynamic map) keeps its own meshes apart,
+ * in mesh_scene, placed in the top scene by one identity instance (id
+ * mesh_inst_id): a commit that only moved instances then rebuilds the top
+ * scene over the instances, not Embree's tree over every triangle of the map.
+ * Instancing such a scene instances its mesh_scene. */
 typedef struct rc__emb_scene {
-    RTCScene scene;
+    RTCScene scene;             /* what rays are traced against */
     uint32_t max_geoms;
     uint32_t max_insts;
     rc__emb_geom *geoms;        /* max_geoms */
     RTCGeometry *insts;         /* max_insts */
+    RTCScene mesh_scene;        /* the own meshes when split, else NULL (they are in scene) */
+    RTCGeometry mesh_inst;      /* scene's identity instance of mesh_scene (once it has meshes) */
+    uint32_t mesh_inst_id;      /* max_geoms + max_insts */
+    uint32_t reserved0;
 } rc__emb_scene;
+
+/* The scene holding es's own meshes, which is what instancing es instances. */
+static inline RTCScene rc__emb_mesh_scene(const rc__emb_scene *es)
+{
+    return es->mesh_scene ? es->mesh_scene : es->scene;
+}
 
 /* embree.c: the backend's one table (registry.c names it too). */
 extern const rc__backend rc__backend_embree;

@@ -38,6 +38,9 @@ typedef struct rc__embree_options {
      * their high-water mark (read only). */
     uint64_t bytes_now;
     uint64_t bytes_peak;
+    /* Every byte the memory monitor let Embree allocate (read only): a
+     * rebuild shows here even when it frees as much as it takes. */
+    uint64_t bytes_allocated;
 } rc__embree_options;
 
 /* The options of an Embree context; NULL when ctx is not one. */

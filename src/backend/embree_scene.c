@@ -262,7 +262,7 @@ static rc_status geometry_create(rc__emb_device *d, rc__emb_scene *es, const rc_
     rtcCommitGeometry(geom);
     st = rc__emb_check(d, "rc_scene_commit (mesh geometry)");
     if (st == RC_OK) {
-        rtcAttachGeometryByID(es->scene, geom, gi);
+        rtcAttachGeometryByID(rc__emb_mesh_scene(es), geom, gi);
         st = rc__emb_check(d, "rc_scene_commit (rtcAttachGeometryByID)");
     }
     if (st != RC_OK) {
@@ -288,6 +288,29 @@ static rc_status geometry_update(rc__emb_device *d, const rc_scene *scene, rc__e
     return rc__emb_check(d, "rc_scene_commit (mesh update)");
 }
 
+/* An instance geometry of child attached to parent by id (the caller sets
+ * its transform and commits it). */
+static rc_status new_instance(rc__emb_device *d, RTCScene parent, RTCScene child, uint32_t id, const char *what,
+                              RTCGeometry *out)
+{
+    RTCGeometry geom = rtcNewGeometry(d->device, RTC_GEOMETRY_TYPE_INSTANCE);
+    rc_status st;
+    if (!geom) {
+        st = rc__emb_check(d, "rc_scene_commit (rtcNewGeometry instance)");
+        return st != RC_OK ? st : rc__fail(d->ctx, RC_ERR_BACKEND, "rc_scene_commit: Embree: rtcNewGeometry failed");
+    }
+    rtcSetGeometryInstancedScene(geom, child);
+    rtcAttachGeometryByID(parent, geom, id);
+    st = rc__emb_check(d, what);
+    if (st != RC_OK) {
+        rtcReleaseGeometry(geom);
+        rc__emb_clear(d);
+        return st;
+    }
+    *out = geom;
+    return RC_OK;
+}
+
 static rc_status instance_set(rc__emb_device *d, rc__emb_scene *es, const rc_scene *scene, uint32_t i)
 {
     const rc__instance *in = &scene->insts[i];
@@ -296,24 +319,9 @@ static rc_status instance_set(rc__emb_device *d, rc__emb_scene *es, const rc_sce
     int r;
     RC_RETURN_IF(d->ctx, src == NULL, RC_ERR_NOT_COMMITTED, "the source scene of instance %u is not committed",
                  (unsigned)i);
-    if (!es->insts[i]) {
-        RTCGeometry geom = rtcNewGeometry(d->device, RTC_GEOMETRY_TYPE_INSTANCE);
-        rc_status st;
-        if (!geom) {
-            st = rc__emb_check(d, "rc_scene_commit (rtcNewGeometry instance)");
-            return st != RC_OK ? st
-                               : rc__fail(d->ctx, RC_ERR_BACKEND, "rc_scene_commit: Embree: rtcNewGeometry failed");
-        }
-        rtcSetGeometryInstancedScene(geom, src->scene);
-        rtcAttachGeometryByID(es->scene, geom, es->max_geoms + i);
-        st = rc__emb_check(d, "rc_scene_commit (instance geometry)");
-        if (st != RC_OK) {
-            rtcReleaseGeometry(geom);
-            rc__emb_clear(d);
-            return st;
-        }
-        es->insts[i] = geom;
-    }
+    if (!es->insts[i])
+        RC_TRY(new_instance(d, es->scene, rc__emb_mesh_scene(src), es->max_geoms + i,
+                            "rc_scene_commit (instance geometry)", &es->insts[i]));
     for (r = 0; r < 3; ++r) {
         m[4 * r] = in->to_world.r[3 * r];
         m[4 * r + 1] = in->to_world.r[3 * r + 1];
@@ -346,9 +354,13 @@ static rc_status scene_state(rc__emb_device *d, rc_scene *scene, rc__emb_scene *
     es->insts = es->max_insts ? (RTCGeometry *)(void *)(block + align16(sizeof *es) +
                                                          align16(es->max_geoms * sizeof(rc__emb_geom)))
                               : NULL;
+    es->mesh_inst_id = es->max_geoms + es->max_insts;
     es->scene = rtcNewScene(d->device);
-    if (!es->scene) {
+    /* a scene that can hold instances keeps its meshes apart (see embree_impl.h) */
+    if (es->scene && es->max_insts > 0) es->mesh_scene = rtcNewScene(d->device);
+    if (!es->scene || (es->max_insts > 0 && !es->mesh_scene)) {
         rc_status st = rc__emb_check(d, "rc_scene_commit (rtcNewScene)");
+        if (es->scene) rtcReleaseScene(es->scene);
         rc__arena_free(&ctx->arena, block);
         return st != RC_OK ? st : rc__fail(ctx, RC_ERR_BACKEND, "rc_scene_commit: Embree: rtcNewScene failed");
     }
@@ -379,12 +391,48 @@ static bool on_progress(void *ptr, double fraction)
 #define RC__EMB_PROGRESS 1
 #endif
 
+/* rtcCommitScene, reporting Embree's build progress to progress (may be NULL). */
+static void commit_scene(RTCScene s, rc_progress_fn progress, void *user)
+{
+#if defined(RC__EMB_PROGRESS)
+    progress_relay relay;
+    relay.fn = progress;
+    relay.user = user;
+    relay.busy = 0;
+    if (progress) rtcSetSceneProgressMonitorFunction(s, on_progress, &relay);
+    rtcCommitScene(s);
+    if (progress) rtcSetSceneProgressMonitorFunction(s, NULL, NULL);
+#else
+    (void)progress;
+    (void)user;
+    rtcCommitScene(s);
+#endif
+}
+
+/* The identity instance that places a split scene's meshes in its top scene
+ * (created once; committed again when the meshes changed, so the top scene
+ * sees their new bounds). */
+static rc_status mesh_instance_set(rc__emb_device *d, rc__emb_scene *es, int meshes_changed)
+{
+    static const float identity[12] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0};
+    if (!es->mesh_inst) {
+        RC_TRY(new_instance(d, es->scene, es->mesh_scene, es->mesh_inst_id, "rc_scene_commit (mesh instance)",
+                            &es->mesh_inst));
+        rtcSetGeometryTransform(es->mesh_inst, 0, RTC_FORMAT_FLOAT3X4_ROW_MAJOR, identity);
+        rtcCommitGeometry(es->mesh_inst);
+    } else if (meshes_changed) {
+        rtcCommitGeometry(es->mesh_inst);
+    }
+    return rc__emb_check(d, "rc_scene_commit (mesh instance)");
+}
+
 rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user)
 {
     rc__emb_device *d = (rc__emb_device *)scene->ctx->backend_data;
     rc__emb_scene *es = NULL;
     struct RTCBounds b;
     uint32_t i;
+    int meshes_changed = 0;
 
     /* Every Embree call sequence is checked where it happens; what is pending
      * here came through the error callback between calls. */
@@ -392,33 +440,34 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
     RC_TRY(scene_state(d, scene, &es));
     rtcSetSceneFlags(es->scene, scene_flags(d, scene));
     rtcSetSceneBuildQuality(es->scene, quality_of(scene));
+    if (es->mesh_scene) {
+        rtcSetSceneFlags(es->mesh_scene, scene_flags(d, scene));
+        rtcSetSceneBuildQuality(es->mesh_scene, quality_of(scene));
+    }
     for (i = 0; i < scene->geom_count; ++i) {
         rc__geometry *geo = &scene->geoms[i];
         rc__emb_geom *g = &es->geoms[i];
-        if (!g->geom)
+        if (!g->geom) {
             RC_TRY(geometry_create(d, es, scene, i));
-        else if (geo->dirty)
+            meshes_changed = 1;
+        } else if (geo->dirty) {
             RC_TRY(geometry_update(d, scene, g, i));
+            meshes_changed = 1;
+        }
         if (!d->options.tie_rule)
             free_dups(d, g);
         else if (!g->dups_done)
             RC_TRY(find_duplicates(d, &geo->mesh, g));
     }
-    for (i = 0; i < scene->inst_count; ++i) RC_TRY(instance_set(d, es, scene, i));
     if (progress) progress(user, "embree build", 0.0);
-#if defined(RC__EMB_PROGRESS)
-    {
-        progress_relay relay;
-        relay.fn = progress;
-        relay.user = user;
-        relay.busy = 0;
-        if (progress) rtcSetSceneProgressMonitorFunction(es->scene, on_progress, &relay);
-        rtcCommitScene(es->scene);
-        if (progress) rtcSetSceneProgressMonitorFunction(es->scene, NULL, NULL);
+    if (es->mesh_scene && scene->geom_count > 0) {
+        /* the map's own tree: rebuilt only when one of its meshes changed */
+        if (meshes_changed || !es->mesh_inst) commit_scene(es->mesh_scene, progress, user);
+        RC_TRY(rc__emb_check(d, "rc_scene_commit (meshes)"));
+        RC_TRY(mesh_instance_set(d, es, meshes_changed));
     }
-#else
-    rtcCommitScene(es->scene);
-#endif
+    for (i = 0; i < scene->inst_count; ++i) RC_TRY(instance_set(d, es, scene, i));
+    commit_scene(es->scene, es->mesh_scene ? NULL : progress, user);
     RC_TRY(rc__emb_check(d, "rc_scene_commit"));
     rtcGetSceneBounds(es->scene, &b);
     scene->bounds.min[0] = b.lower_x;
@@ -441,6 +490,8 @@ void rc__emb_scene_release(rc_scene *scene)
     if (!es) return;
     for (i = 0; i < es->max_insts; ++i)
         if (es->insts[i]) rtcReleaseGeometry(es->insts[i]);
+    if (es->mesh_inst) rtcReleaseGeometry(es->mesh_inst);
+    if (es->mesh_scene) rtcReleaseScene(es->mesh_scene);
     for (i = 0; i < es->max_geoms; ++i) {
         if (es->geoms[i].geom) rtcReleaseGeometry(es->geoms[i].geom);
         free_dups(d, &es->geoms[i]);

@@ -122,7 +122,9 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t r, flo
     hit->geom = geom;
     hit->prim = prim;
     hit->slot = RC_INVALID_ID; /* Embree's own order */
-    hit->inst = inst == RTC_INVALID_GEOMETRY_ID ? RC_INVALID_ID : inst - run->es->max_geoms;
+    /* the own meshes: directly, or through a split scene's identity instance */
+    hit->inst = inst == RTC_INVALID_GEOMETRY_ID || inst == run->es->mesh_inst_id ? RC_INVALID_ID
+                                                                                : inst - run->es->max_geoms;
     if (run->dups) {
         const rc__emb_scene *src = run->es;
         if (hit->inst != RC_INVALID_ID)
