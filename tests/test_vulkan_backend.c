@@ -479,9 +479,10 @@ static void test_no_driver(void **state)
 /* A dynamic map on the device: a static sphere (the map) and three instanced
  * boxes moved between scans. A commit that only moved instances rewrites
  * their records and the top level in place (no new device memory), and the
- * scans match the built-in backend's after every move; adding an instance or
- * changing a source's mesh uploads everything again. Mapped and staged uploads
- * (RANGECAST_VULKAN_STAGING), so both ways of writing the top are covered. */
+ * scans match the built-in backend's after every move; a mesh updated in
+ * place (the map's own, or a source's) has its sections rewritten in place
+ * where device memory is mapped and everything uploaded where it is staged
+ * (RANGECAST_VULKAN_STAGING); adding an instance uploads everything. */
 typedef struct dyn_world {
     rc_context *ctx;
     rc_scene *box, *world;
@@ -580,7 +581,7 @@ static void test_dynamic_commit_rewrites_only_the_top(void **state)
         dyn_world v, c;
         rct_buffers bv, bc;
         rc_memory_stats m0 = rc_memory_stats_default(), m1 = rc_memory_stats_default();
-        uint32_t full = 0, top = 0, step;
+        uint32_t full = 0, top = 0, meshes = 0, step;
         if (staged) setenv("RANGECAST_VULKAN_STAGING", "1", 1);
         dyn_make(&v, RC_BACKEND_VULKAN, &sphere);
         unsetenv("RANGECAST_VULKAN_STAGING");
@@ -592,12 +593,15 @@ static void test_dynamic_commit_rewrites_only_the_top(void **state)
             /* after the first scan (which sets up the per-call buffers) */
             if (step == 1) RCT_OK(v.ctx, rc_context_get_memory_stats(v.ctx, &m0));
         }
-        rc__vk_debug_scene_uploads(v.world, &full, &top);
+        rc__vk_debug_scene_uploads(v.world, &full, &top, &meshes);
         assert_int_equal(full, 1);
         assert_int_equal(top, 4);
+        assert_int_equal(meshes, 0);
         RCT_OK(v.ctx, rc_context_get_memory_stats(v.ctx, &m1));
         assert_true(m1.device_bytes == m0.device_bytes); /* the same buffers, rewritten */
-        /* a source's mesh changed (and re-committed): everything again */
+        /* a source's mesh changed (and re-committed): its sections rewritten
+         * in place where device memory is mapped, everything uploaded where
+         * it is staged */
         v.box_mesh.vertices[0] += 0.25f;
         c.box_mesh.vertices[0] += 0.25f;
         RCT_OK(v.ctx, rc_scene_update_mesh(v.box, 0));
@@ -605,8 +609,20 @@ static void test_dynamic_commit_rewrites_only_the_top(void **state)
         RCT_OK(v.ctx, rc_scene_commit(v.box));
         RCT_OK(c.ctx, rc_scene_commit(c.box));
         dyn_step(&v, &c, 5, &bv, &bc, n);
-        rc__vk_debug_scene_uploads(v.world, &full, &top);
-        assert_int_equal(full, 2);
+        /* the map's own mesh updated in place (both worlds reference it):
+         * shrunk by 2%, so every range that reaches it changes, then back */
+        for (step = 0; step < 3u * sphere.vertex_count; ++step) sphere.vertices[step] *= 0.98f;
+        RCT_OK(v.ctx, rc_scene_update_mesh(v.world, 0));
+        RCT_OK(c.ctx, rc_scene_update_mesh(c.world, 0));
+        dyn_step(&v, &c, 6, &bv, &bc, n);
+        for (step = 0; step < 3u * sphere.vertex_count; ++step) sphere.vertices[step] /= 0.98f;
+        RCT_OK(v.ctx, rc_scene_update_mesh(v.world, 0));
+        RCT_OK(c.ctx, rc_scene_update_mesh(c.world, 0));
+        dyn_step(&v, &c, 7, &bv, &bc, n);
+        rc__vk_debug_scene_uploads(v.world, &full, &top, &meshes);
+        assert_int_equal(full, staged ? 4 : 1);
+        assert_int_equal(meshes, staged ? 0 : 3);
+        assert_int_equal(top, 4);
         /* one more instance: the layout changes, the next commit uploads */
         {
             rc_instance_desc in = rc_instance_desc_default();
@@ -617,10 +633,9 @@ static void test_dynamic_commit_rewrites_only_the_top(void **state)
             in.source = c.box;
             RCT_OK(c.ctx, rc_scene_add_instance(c.world, &in, &id));
         }
-        dyn_step(&v, &c, 6, &bv, &bc, n);
-        rc__vk_debug_scene_uploads(v.world, &full, &top);
-        assert_int_equal(full, 3); /* a new instance: the layout changed */
-        assert_int_equal(top, 4);
+        dyn_step(&v, &c, 8, &bv, &bc, n);
+        rc__vk_debug_scene_uploads(v.world, &full, &top, &meshes);
+        assert_int_equal(full, staged ? 5 : 2); /* a new instance: the layout changed */
         rct_buffers_free(&bv);
         rct_buffers_free(&bc);
         dyn_free(&v);

@@ -128,11 +128,12 @@ void rc__vk_debug_mark_lost(rc_context *ctx)
     if (rc__context_valid(ctx) && ctx->backend_id == RC_BACKEND_VULKAN && rc__vk(ctx)) rc__vk(ctx)->lost = 1;
 }
 
-void rc__vk_debug_scene_uploads(const rc_scene *scene, uint32_t *full, uint32_t *top)
+void rc__vk_debug_scene_uploads(const rc_scene *scene, uint32_t *full, uint32_t *top, uint32_t *meshes)
 {
     const rc__vk_scene *sv = (const rc__vk_scene *)scene->backend_scene;
     *full = sv ? sv->full_uploads : 0u;
     *top = sv ? sv->top_updates : 0u;
+    *meshes = sv ? sv->mesh_updates : 0u;
 }
 
 const char *rc__vk_device_name(const rc_context *ctx, int *fp64, uint32_t *chunks)

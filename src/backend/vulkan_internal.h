@@ -89,7 +89,8 @@ typedef struct rc__vk_scene {
      * level (vulkan_scene.c) */
     uint32_t current;
     uint32_t up_geoms, up_insts;  /* geometries and instances the device arrays hold */
-    uint32_t full_uploads, top_updates; /* commits of each kind (test hook) */
+    uint32_t full_uploads, top_updates, mesh_updates; /* commits of each kind (test hook) */
+    uint32_t reserved1;
 } rc__vk_scene;
 
 typedef struct rc__vk_pipeline {
@@ -241,6 +242,12 @@ const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
 void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info);
 /* Writes them (after rc__vk_pack_count with the same serial). */
 void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
+/* Writes again, into arrays packed before with the same layout, only the
+ * meshes that changed (own geometry g where changed[g]; every mesh of an
+ * instanced source re-committed since the scene's last commit), then the
+ * instance records and the top level (after rc__vk_pack_count with serial). */
+void rc__vk_pack_refill(rc_scene *scene, uint32_t serial, const uint8_t *changed, const rc__vk_pack_info *info,
+                        const rc__vk_pack_dst *dst);
 /* Writes only what a commit that moved instances changes: the instance
  * records and the top level's nodes and refs (after rc__vk_pack_count). */
 void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
@@ -296,9 +303,10 @@ rc_status rc__vk_device_results(rc_context *ctx, rc_device_results *out);
 rc_status rc__vk_layout_check(rc_context *ctx);
 /* Test hook: behave as if the device had been lost. */
 void rc__vk_debug_mark_lost(rc_context *ctx);
-/* Test hook: how many commits of the scene uploaded everything and how many
- * only rewrote the instances and the top level. */
-void rc__vk_debug_scene_uploads(const rc_scene *scene, uint32_t *full, uint32_t *top);
+/* Test hook: how many commits of the scene uploaded everything, how many
+ * only rewrote the instances and the top level, and how many rewrote the
+ * changed meshes in place too. */
+void rc__vk_debug_scene_uploads(const rc_scene *scene, uint32_t *full, uint32_t *top, uint32_t *meshes);
 /* Test hook: the device name and whether the float64 kernel runs. */
 const char *rc__vk_device_name(const rc_context *ctx, int *fp64, uint32_t *chunks);
 

@@ -77,6 +77,16 @@ typedef struct pack_cursor {
 
 #define PACK_BATCH 512u
 
+/* Moves the cursor past m's sections, as fill_mesh does when it writes them. */
+static void skip_mesh(const rc__mesh *m, pack_cursor *c)
+{
+    c->node = pair_aligned(c->node) + m->bvh.node_count;
+    c->ref += m->bvh.item_count;
+    c->tri += m->triangle_count;
+    c->vert += m->vertex_count;
+    c->geom += 1u;
+}
+
 static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst *dst, pack_cursor *c)
 {
     rc__vk_geom entry;
@@ -116,11 +126,7 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst
         for (k = 0; k < n; ++k) memcpy(vbatch + 3u * k, m->vertices + (size_t)(i + k) * m->stride, 3 * sizeof(float));
         span_write(&dst->verts, c->vert + i, vbatch, n);
     }
-    c->node += m->bvh.node_count;
-    c->ref += m->bvh.item_count;
-    c->tri += m->triangle_count;
-    c->vert += m->vertex_count;
-    c->geom += 1u;
+    skip_mesh(m, c);
 }
 
 /* Instance i's record: its transforms and where its source's meshes are
@@ -164,6 +170,35 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
     if (c.node < info->top_node) {
         static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
         span_write(&dst->nodes, c.node, &pad, 1);
+    }
+    rc__vk_pack_fill_top(scene, info, dst);
+}
+
+void rc__vk_pack_refill(rc_scene *scene, uint32_t serial, const uint8_t *changed, const rc__vk_pack_info *info,
+                        const rc__vk_pack_dst *dst)
+{
+    pack_cursor c;
+    uint32_t g, i;
+    memset(&c, 0, sizeof c);
+    for (g = 0; g < scene->geom_count; ++g) {
+        if (changed[g])
+            fill_mesh(&scene->geoms[g].mesh, g, dst, &c);
+        else
+            skip_mesh(&scene->geoms[g].mesh, &c);
+    }
+    for (i = 0; i < scene->inst_count; ++i) {
+        const rc_scene *source = scene->insts[i].source;
+        rc__vk_scene *sv = vk_scene_of(source);
+        /* every instance of a source saw the same version at the last commit */
+        const int moved = source->version != scene->source_versions[i];
+        if (sv->fill_serial == serial) continue;
+        sv->fill_serial = serial;
+        for (g = 0; g < source->geom_count; ++g) {
+            if (moved)
+                fill_mesh(&source->geoms[g].mesh, g, dst, &c);
+            else
+                skip_mesh(&source->geoms[g].mesh, &c);
+        }
     }
     rc__vk_pack_fill_top(scene, info, dst);
 }

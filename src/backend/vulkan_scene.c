@@ -11,10 +11,12 @@
  * checked before allocating so it never reaches the driver's limits.
  * With the ray query traversal the commit also builds the driver's
  * acceleration structures (vulkan_accel.c).
- * A commit after moving instances only (a dynamic map: a large static map
- * and a few moving objects) keeps the buffers and rewrites the instance
- * records and the top level in place, and rebuilds only the top-level
- * acceleration structure: its cost is the instances', not the map's.
+ * A commit that keeps the packed layout (a dynamic map: a large static map,
+ * a few moving objects, maybe a mesh updated in place) keeps the buffers:
+ * after moving instances it rewrites the instance records and the top level
+ * and rebuilds only the top-level acceleration structure (its cost is the
+ * instances', not the map's); where device memory is mapped it also rewrites
+ * the sections of the meshes that changed.
  * Arena use: the rc__vk_scene record plus the BVH (rc__scene_bvh_commit_bytes). */
 #include "backend/vulkan_internal.h"
 
@@ -93,19 +95,27 @@ static void span_of(const array_plan *a, const rc__vk_buffer *staging, rc__vk_sp
         s->chunk[c] = staging ? (unsigned char *)staging->map + a->staging_off[c] : (unsigned char *)a->bufs[c].map;
 }
 
-/* 1 when the device arrays hold this scene's meshes as they are now, laid out
- * as they will be: the last commit succeeded, no mesh was added, updated or
- * re-committed in a source since, and no instance was added. Read before the
- * build, which clears the meshes' dirty marks. */
-static int meshes_unchanged(const rc_scene *scene, const rc__vk_scene *sv)
+/* 1 when the device arrays hold this scene as of its last successful commit
+ * and the packed layout can stay: no mesh or instance added since (a mesh
+ * updated in place, or a source committed again, keeps the counts). */
+static int layout_kept(const rc_scene *scene, const rc__vk_scene *sv)
+{
+    return sv->current && sv->up_geoms == scene->geom_count && sv->up_insts == scene->inst_count;
+}
+
+/* changed[g] = own mesh g changed since the last commit (read before the
+ * build, which clears the dirty marks); returns 1 when a mesh changed, own
+ * or in an instanced source committed again since. */
+static int meshes_changed(const rc_scene *scene, uint8_t *changed)
 {
     uint32_t i;
-    if (!sv->current || sv->up_geoms != scene->geom_count || sv->up_insts != scene->inst_count) return 0;
-    for (i = 0; i < scene->geom_count; ++i)
-        if (scene->geoms[i].dirty) return 0;
-    for (i = 0; i < scene->inst_count; ++i)
-        if (scene->insts[i].source->version != scene->source_versions[i]) return 0;
-    return 1;
+    int any = 0;
+    for (i = 0; i < scene->geom_count; ++i) {
+        changed[i] = scene->geoms[i].dirty != 0;
+        any |= changed[i];
+    }
+    for (i = 0; i < scene->inst_count; ++i) any |= scene->insts[i].source->version != scene->source_versions[i];
+    return any;
 }
 
 /* A span over one device array's buffers (mapped, or a staging map). */
@@ -137,11 +147,14 @@ static rc_status copy_chunked(rc__vk_state *st, const rc__vk_buffer *staging, Vk
     return RC_OK;
 }
 
-/* The commit of a scene whose meshes did not change: the instance records
- * and the top level rewritten in place, the rest of the device arrays (and,
- * for ray query, the bottom levels) kept. *done 0 when the packed layout
- * differs after all (the caller uploads everything). */
-static rc_status update_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv, int *done)
+/* A commit that keeps the packed layout, in place: with changed NULL (no
+ * mesh changed) the instance records and the top level rewritten, the rest
+ * of the device arrays (and, for ray query, the bottom levels) kept; with
+ * changed (mapped device memory only) the changed meshes' sections too, and
+ * the ray query structures built again. *done 0 when the layout differs
+ * after all (the caller uploads everything). */
+static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv, const uint8_t *changed,
+                                 int *done)
 {
     rc__vk_pack_info info;
     rc__vk_pack_dst dst;
@@ -160,11 +173,22 @@ static rc_status update_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv,
     memset(&dst, 0, sizeof dst);
     if (st->device_mappable) {
         dst.nodes = span_over(sv->nodes, sv->node_chunks, st->node_shift, (uint32_t)sizeof(rc__bvh_node));
+        dst.tris = span_over(sv->tris, sv->tri_chunks, st->tri_shift, 12u);
+        dst.verts = span_over(sv->verts, sv->vert_chunks, st->vert_shift, 12u);
         dst.refs = span_over(&sv->refs, 1, 31u, 4u);
+        dst.geoms = span_over(&sv->geoms, 1, 31u, (uint32_t)sizeof(rc__vk_geom));
         dst.insts = span_over(&sv->insts, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
-        rc__vk_pack_fill_top(scene, &info, &dst);
-        for (c = 0; c < sv->node_chunks && s == RC_OK; ++c) s = rc__vk_buffer_flush(st, &sv->nodes[c]);
+        if (changed)
+            rc__vk_pack_refill(scene, serial, changed, &info, &dst);
+        else
+            rc__vk_pack_fill_top(scene, &info, &dst);
+        for (c = 0; c < RC__VK_MAX_CHUNKS && s == RC_OK; ++c) {
+            if (c < sv->node_chunks) s = rc__vk_buffer_flush(st, &sv->nodes[c]);
+            if (s == RC_OK && changed && c < sv->tri_chunks) s = rc__vk_buffer_flush(st, &sv->tris[c]);
+            if (s == RC_OK && changed && c < sv->vert_chunks) s = rc__vk_buffer_flush(st, &sv->verts[c]);
+        }
         if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->refs);
+        if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->geoms);
         if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->insts);
     } else {
         /* staged: records, nodes and refs one after another, then copied */
@@ -186,7 +210,8 @@ static rc_status update_top(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv,
                                    ref_bytes);
         rc__vk_buffer_destroy(st, &staging);
     }
-    if (s == RC_OK && st->ray_query) s = rc__vk_accel_update_top(scene, serial);
+    if (s == RC_OK && st->ray_query)
+        s = changed ? rc__vk_accel_build(scene, serial) : rc__vk_accel_update_top(scene, serial);
     return s;
 }
 
@@ -213,21 +238,28 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
         scene->backend_scene = sv;
     }
     {
-        const int unchanged = meshes_unchanged(scene, sv);
-        int done = 0;
+        /* what the last upload lets this commit keep, judged before the build */
+        int in_place = layout_kept(scene, sv), changed_meshes = 0, done = 0;
+        uint8_t *changed = in_place ? (uint8_t *)rc__vk_host_alloc(st, scene->geom_count + 1u) : NULL;
+        if (changed) changed_meshes = meshes_changed(scene, changed);
+        /* changed meshes are rewritten in place where device memory is mapped
+         * (UMA boards, lavapipe); staged, they go up with everything else */
+        in_place = changed != NULL && (!changed_meshes || st->device_mappable);
         sv->current = 0; /* until this commit succeeds */
-        RC_TRY(rc__scene_build_bvh(scene, progress, user));
-        if (unchanged) {
-            s = update_top(st, scene, sv, &done);
-            if (s != RC_OK) {
-                release_buffers(st, sv);
-                return s;
-            }
-            if (done) {
+        s = rc__scene_build_bvh(scene, progress, user);
+        if (s == RC_OK && in_place) {
+            s = update_in_place(st, scene, sv, changed_meshes ? changed : NULL, &done);
+            if (s != RC_OK) release_buffers(st, sv);
+        }
+        rc__vk_host_free(st, changed);
+        if (s != RC_OK) return s;
+        if (done) {
+            if (changed_meshes)
+                sv->mesh_updates++;
+            else
                 sv->top_updates++;
-                sv->current = 1;
-                return RC_OK;
-            }
+            sv->current = 1;
+            return RC_OK;
         }
     }
     release_buffers(st, sv);
