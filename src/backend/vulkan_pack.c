@@ -39,43 +39,9 @@ static rc__vk_scene *vk_scene_of(const rc_scene *scene) { return (rc__vk_scene *
  * sibling pairs (at odd indices within it) then fill whole 64-byte lines. */
 static uint64_t pair_aligned(uint64_t node) { return node | 1u; }
 
-static void count_mesh(const rc__mesh *m, rc__vk_pack_info *info)
-{
-    info->nodes = pair_aligned(info->nodes) + m->bvh.node_count;
-    info->refs += m->bvh.item_count;
-    info->tris += m->triangle_count;
-    info->verts += m->vertex_count;
-    info->geoms += 1u;
-}
-
-void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
-{
-    uint32_t g, i;
-    memset(info, 0, sizeof *info);
-    for (g = 0; g < scene->geom_count; ++g) count_mesh(&scene->geoms[g].mesh, info);
-    for (i = 0; i < scene->inst_count; ++i) {
-        const rc_scene *src = scene->insts[i].source;
-        rc__vk_scene *sv = vk_scene_of(src);
-        if (sv->pack_serial == serial) continue;
-        sv->pack_serial = serial;
-        sv->pack_first_geom = (uint32_t)info->geoms;
-        for (g = 0; g < src->geom_count; ++g) count_mesh(&src->geoms[g].mesh, info);
-    }
-    info->insts = scene->inst_count;
-    info->geom_count = scene->geom_count;
-    info->top_node = (uint32_t)pair_aligned(info->nodes);
-    info->top_ref = (uint32_t)info->refs;
-    info->nodes = info->top_node;
-    info->nodes += scene->top.node_count;
-    info->refs += scene->top.item_count;
-    info->flags = (scene->geom_count == 1 && scene->inst_count == 0) ? 1u : 0u;
-}
-
 typedef struct pack_cursor {
     uint64_t node, ref, tri, vert, geom;
 } pack_cursor;
-
-#define PACK_BATCH 512u
 
 /* Moves the cursor past m's sections, as fill_mesh does when it writes them. */
 static void skip_mesh(const rc__mesh *m, pack_cursor *c)
@@ -86,6 +52,38 @@ static void skip_mesh(const rc__mesh *m, pack_cursor *c)
     c->vert += m->vertex_count;
     c->geom += 1u;
 }
+
+void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
+{
+    pack_cursor c;
+    uint32_t g, i;
+    memset(info, 0, sizeof *info);
+    memset(&c, 0, sizeof c);
+    for (g = 0; g < scene->geom_count; ++g) skip_mesh(&scene->geoms[g].mesh, &c);
+    for (i = 0; i < scene->inst_count; ++i) {
+        const rc_scene *src = scene->insts[i].source;
+        rc__vk_scene *sv = vk_scene_of(src);
+        if (sv->pack_serial == serial) continue;
+        sv->pack_serial = serial;
+        sv->pack_first_geom = (uint32_t)c.geom;
+        for (g = 0; g < src->geom_count; ++g) skip_mesh(&src->geoms[g].mesh, &c);
+    }
+    info->nodes = c.node;
+    info->refs = c.ref;
+    info->tris = c.tri;
+    info->verts = c.vert;
+    info->geoms = c.geom;
+    info->insts = scene->inst_count;
+    info->geom_count = scene->geom_count;
+    info->top_node = (uint32_t)pair_aligned(info->nodes);
+    info->top_ref = (uint32_t)info->refs;
+    info->nodes = info->top_node;
+    info->nodes += scene->top.node_count;
+    info->refs += scene->top.item_count;
+    info->flags = (scene->geom_count == 1 && scene->inst_count == 0) ? 1u : 0u;
+}
+
+#define PACK_BATCH 512u
 
 static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst *dst, pack_cursor *c)
 {
