@@ -10,7 +10,6 @@ RC=$1
 WORK=$2
 shift 2
 BACKEND=${*:-}
-DATA=$(cd "$(dirname "$0")/../data" && pwd)
 . "$(dirname "$0")/common.sh"
 
 run 0 "" "$RC" gen --sphere 10k --radius 20 -o sphere.ply

@@ -1,5 +1,7 @@
 # Shared by the tests/cli/check_*.sh scripts (sourced, after they set RC and
-# WORK): a fresh work directory to run in, and the helpers below.
+# WORK): DATA (tests/data, absolute), a fresh work directory to run in, and
+# the helpers below.
+DATA=$(cd "$(dirname "$0")/../data" && pwd)
 rm -rf "$WORK"
 mkdir -p "$WORK"
 cd "$WORK"
