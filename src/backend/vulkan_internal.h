@@ -88,9 +88,7 @@ typedef struct rc__vk_scene {
      * only moved instances then rewrites only their records and the top
      * level (vulkan_scene.c) */
     uint32_t current;
-    uint32_t up_geoms, up_insts;  /* geometries and instances the device arrays hold */
     uint32_t full_uploads, top_updates, mesh_updates; /* commits of each kind (test hook) */
-    uint32_t reserved1;
 } rc__vk_scene;
 
 typedef struct rc__vk_pipeline {

@@ -100,7 +100,7 @@ static void span_of(const array_plan *a, const rc__vk_buffer *staging, rc__vk_sp
  * updated in place, or a source committed again, keeps the counts). */
 static int layout_kept(const rc_scene *scene, const rc__vk_scene *sv)
 {
-    return sv->current && sv->up_geoms == scene->geom_count && sv->up_insts == scene->inst_count;
+    return sv->current && sv->info.geom_count == scene->geom_count && sv->info.insts == scene->inst_count;
 }
 
 /* changed[g] = own mesh g changed since the last commit (read before the
@@ -347,8 +347,6 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
     if (s == RC_OK && st->ray_query) s = rc__vk_accel_build(scene, serial);
     if (s != RC_OK) goto fail;
     sv->info = info;
-    sv->up_geoms = scene->geom_count;
-    sv->up_insts = scene->inst_count;
     sv->full_uploads++;
     sv->current = 1;
     return RC_OK;
