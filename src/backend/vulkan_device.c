@@ -652,28 +652,53 @@ typedef struct rq_features {
 
 /* The chosen device has what the ray query traversal needs: Vulkan 1.2, the
  * extensions and their features. RC_ERR_UNSUPPORTED naming what is missing. */
+/* The device's extension names, through the counting allocator (a list on
+ * the stack would be 260 bytes an entry, on a thread whose stack may be
+ * small; a fixed-size one could come back VK_INCOMPLETE). */
+static rc_status device_extensions(rc__vk_state *st, VkExtensionProperties **out, uint32_t *count)
+{
+    uint32_t n = 0;
+    VkResult r = vkEnumerateDeviceExtensionProperties(st->phys, NULL, &n, NULL);
+    *out = NULL;
+    *count = 0;
+    if (r != VK_SUCCESS) return rc__vk_fail(st, r, "vkEnumerateDeviceExtensionProperties");
+    *out = (VkExtensionProperties *)rc__vk_host_alloc(st, (size_t)(n ? n : 1) * sizeof **out);
+    RC_RETURN_IF(st->ctx, *out == NULL, RC_ERR_OUT_OF_MEMORY, "vulkan: no host memory for %u extension names",
+                 (unsigned)n);
+    r = vkEnumerateDeviceExtensionProperties(st->phys, NULL, &n, *out);
+    if (r != VK_SUCCESS && r != VK_INCOMPLETE) {
+        rc__vk_host_free(st, *out);
+        *out = NULL;
+        return rc__vk_fail(st, r, "vkEnumerateDeviceExtensionProperties");
+    }
+    *count = n;
+    return RC_OK;
+}
+
 static rc_status ray_query_support(rc__vk_state *st)
 {
-    VkExtensionProperties ext[512];
-    uint32_t n = 512, i, k;
+    VkExtensionProperties *ext;
+    uint32_t n, i, k;
     VkPhysicalDeviceFeatures2 f2;
     VkPhysicalDeviceAccelerationStructurePropertiesKHR ap;
     VkPhysicalDeviceProperties2 p2;
     rq_features rq;
-    VkResult r;
     RC_RETURN_IF(st->ctx, st->props.apiVersion < VK_API_VERSION_1_2, RC_ERR_UNSUPPORTED,
                  "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs Vulkan 1.2; %s has %u.%u", st->device_name,
                  (unsigned)VK_VERSION_MAJOR(st->props.apiVersion), (unsigned)VK_VERSION_MINOR(st->props.apiVersion));
-    r = vkEnumerateDeviceExtensionProperties(st->phys, NULL, &n, ext);
-    if (r != VK_SUCCESS && r != VK_INCOMPLETE) return rc__vk_fail(st, r, "vkEnumerateDeviceExtensionProperties");
+    RC_TRY(device_extensions(st, &ext, &n));
     for (k = 0; k < sizeof ray_query_extensions / sizeof ray_query_extensions[0]; ++k) {
         int found = 0;
         for (i = 0; i < n && !found; ++i) found = strcmp(ext[i].extensionName, ray_query_extensions[k]) == 0;
-        RC_RETURN_IF(st->ctx, !found, RC_ERR_UNSUPPORTED,
-                     "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs %s, which %s does not offer (Mesa's lavapipe has "
-                     "it from 23.1 on)",
-                     ray_query_extensions[k], st->device_name);
+        if (!found) {
+            rc__vk_host_free(st, ext);
+            return rc__fail(st->ctx, RC_ERR_UNSUPPORTED,
+                            "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs %s, which %s does not offer (Mesa's lavapipe "
+                            "has it from 23.1 on)",
+                            ray_query_extensions[k], st->device_name);
+        }
     }
+    rc__vk_host_free(st, ext);
     memset(&rq, 0, sizeof rq);
     rq.bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
     rq.bda.pNext = &rq.accel;
