@@ -66,8 +66,8 @@ static const char *header_problem(const rcp_baked *b, rc_status st)
     return text;
 }
 
-/* Copies geometry g of b into out after what out holds (vertex indices
- * offset by it; out has the room). */
+/* Copies a geometry of a baked map into out after what out holds (vertex
+ * indices offset by it; out has the room). */
 static void append_geometry(const rc_mesh_desc *md, rcu_mesh *out)
 {
     const uint64_t v0 = out->vertex_count, t0 = out->triangle_count;
@@ -82,32 +82,38 @@ static void append_geometry(const rc_mesh_desc *md, rcu_mesh *out)
 int rcp_baked_load_mesh(const char *path, rcu_mesh *out)
 {
     rcp_baked b;
-    rc_mesh_desc md = rc_mesh_desc_default();
+    rc_mesh_desc *md = NULL;
     uint32_t geoms = 0, g;
     uint64_t *first = NULL, vertices = 0, triangles = 0;
     rc_status st;
     memset(out, 0, sizeof *out);
     if (map_count == MAX_MAPS) return rcu_fail("%s: more than %d baked maps open", path, MAX_MAPS);
     if (map_file(path, &b) != 0) return -1;
-    st = rc_baked_get_mesh(b.blob, b.bytes, 0, &md, &geoms);
-    for (g = 0; st == RC_OK && g < geoms; ++g) /* the sizes first: one copy holds them all */
-        if ((st = rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL)) == RC_OK) {
-            vertices += md.vertex_count;
-            triangles += md.triangle_count;
+    st = rc_baked_get_mesh(b.blob, b.bytes, 0, NULL, &geoms);
+    if (st == RC_OK) {
+        md = (rc_mesh_desc *)malloc(sizeof *md * ((size_t)geoms + 1u));
+        first = (uint64_t *)malloc(sizeof *first * ((size_t)geoms + 1u));
+    }
+    for (g = 0; st == RC_OK && md && g < geoms; ++g) { /* the sizes first: one copy holds them all */
+        md[g] = rc_mesh_desc_default();
+        if ((st = rc_baked_get_mesh(b.blob, b.bytes, g, &md[g], NULL)) == RC_OK) {
+            vertices += md[g].vertex_count;
+            triangles += md[g].triangle_count;
         }
+    }
     if (st != RC_OK) {
         rcu_fail("%s: %s; bake it again with 'rangecast bake'", path, header_problem(&b, st));
-    } else if (!(first = (uint64_t *)malloc(sizeof *first * ((size_t)geoms + 1u)))) {
+    } else if (!md || !first) {
         rcu_fail("%s: out of memory for %u geometry records", path, (unsigned)geoms);
     } else if (rcu_mesh_reserve(out, vertices, triangles) == 0) {
         /* the geometries one after another in one copy: the commands' float64
          * reference finds a hit's triangle at first[geom id] + prim id */
         for (g = 0; g < geoms; ++g) {
             first[g] = out->triangle_count;
-            (void)rc_baked_get_mesh(b.blob, b.bytes, g, &md, NULL); /* read above: cannot fail */
-            append_geometry(&md, out);
+            append_geometry(&md[g], out);
         }
         first[geoms] = out->triangle_count;
+        free(md);
         maps[map_count].vertices = out->vertices;
         maps[map_count].baked = b;
         maps[map_count].first_triangle = first;
@@ -117,6 +123,7 @@ int rcp_baked_load_mesh(const char *path, rcu_mesh *out)
     } else {
         rcu_fail("%s: %s", path, rcu_last_error());
     }
+    free(md);
     free(first);
     rcu_mesh_free(out);
     munmap((void *)(uintptr_t)b.blob, b.bytes);
