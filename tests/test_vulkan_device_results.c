@@ -208,9 +208,11 @@ static void test_device_results_match_host(void **state)
  * same noise (so both use draw `calls - 1` on their last call): hit flags
  * (dropout) equal, ranges and points within tol (metres, plus 1e-6
  * relative). *moved counts returns whose range (or, without ranges, point)
- * the noise changed; returns how many of those ranges were bit-identical. */
+ * the noise changed; returns how many of those ranges were bit-identical;
+ * *max_diff gets the largest range difference (m). */
 static uint64_t compare_noisy(rc_context *ctx, rc_scene *scene, const rc_noise_desc *noise, uint32_t attributes,
-                              const rc_pose *poses, uint32_t pose_count, uint32_t calls, double tol, uint64_t *moved)
+                              const rc_pose *poses, uint32_t pose_count, uint32_t calls, double tol, uint64_t *moved,
+                              double *max_diff)
 {
     rc_sensor *hs, *ds, *clean;
     rct_buffers host, ref;
@@ -243,6 +245,7 @@ static uint64_t compare_noisy(rc_context *ctx, rc_scene *scene, const rc_noise_d
     read_device_buffer(&dr, &rb);
     base = (const unsigned char *)rb.map;
     *moved = 0;
+    *max_diff = 0.0;
     for (k = 0; k < n; ++k) {
         if (attributes & RC_ATTR_HITS) {
             uint32_t h;
@@ -262,6 +265,8 @@ static uint64_t compare_noisy(rc_context *ctx, rc_scene *scene, const rc_noise_d
                 fail_msg("element %llu: range %.9g on the device, %.9g on the host", (unsigned long long)k, (double)r,
                          (double)want);
             }
+            if (isfinite(want) && isfinite(r) && fabs((double)r - (double)want) > *max_diff)
+                *max_diff = fabs((double)r - (double)want);
             if (isfinite(want) && want != ref.res.ranges[k]) {
                 ++*moved;
                 same += memcmp(&r, &want, 4) == 0;
@@ -316,22 +321,25 @@ static void test_device_noise_matches_host(void **state)
         rc_context *ctx;
         rc_scene *scene;
         uint64_t moved = 0, n = 3u * 16u * 900u, same;
+        double diff = 0.0;
         if (!fp64_kernel) setenv("RANGECAST_VULKAN_NO_FP64", "1", 1);
         ctx = rct_context(RC_BACKEND_VULKAN, 2, 0);
         if (!fp64_kernel) unsetenv("RANGECAST_VULKAN_NO_FP64");
         scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
         /* every attribute, the second call's draw */
-        same = compare_noisy(ctx, scene, &flat, RC_ATTR_ALL, poses, 3, 2, tol, &moved);
-        print_message("%s kernel, constant noise and dropout: %llu of %llu moved ranges bit-identical\n",
-                      fp64_kernel ? "float64" : "float-only", (unsigned long long)same, (unsigned long long)moved);
+        same = compare_noisy(ctx, scene, &flat, RC_ATTR_ALL, poses, 3, 2, tol, &moved, &diff);
+        print_message("%s kernel, constant noise and dropout: %llu of %llu moved ranges bit-identical, "
+                      "largest difference %.3g m (sigma %g m)\n",
+                      fp64_kernel ? "float64" : "float-only", (unsigned long long)same, (unsigned long long)moved,
+                      diff, (double)flat.sigma);
         assert_true(moved > n / 2u); /* the noise is there: 3/4 of the returns kept, all of them moved */
         if (fp64_kernel) assert_true(same * 100u >= moved * 99u);
         /* points only (the range comes from the point), noise growing with range */
-        (void)compare_noisy(ctx, scene, &grow, RC_ATTR_POINTS | RC_ATTR_HITS, poses, 3, 1, tol, &moved);
+        (void)compare_noisy(ctx, scene, &grow, RC_ATTR_POINTS | RC_ATTR_HITS, poses, 3, 1, tol, &moved, &diff);
         assert_true(moved > n / 2u);
         /* dropout alone, hits alone: the same returns lost */
         flat.sigma = flat.mean = 0.0f;
-        (void)compare_noisy(ctx, scene, &flat, RC_ATTR_HITS, poses, 3, 1, 0.0, &moved);
+        (void)compare_noisy(ctx, scene, &flat, RC_ATTR_HITS, poses, 3, 1, 0.0, &moved, &diff);
         flat.sigma = 0.03f;
         flat.mean = 0.01f;
         rc_context_destroy(ctx);
