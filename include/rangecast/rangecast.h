@@ -374,9 +374,10 @@ RC_API rc_status rc_scene_add_mesh(rc_scene *scene, const rc_mesh_desc *desc, ui
 /* Tells the scene a referenced mesh's vertices changed (same counts). The next
  * commit refits that mesh's BVH instead of rebuilding it (built-in backend;
  * Vulkan rewrites that mesh alone where device memory is mapped). Embree
- * builds one tree over all of a scene's own meshes, so updating a small mesh
- * beside a large one rebuilds both there (about 0.4 s beside a 1M-triangle
- * mesh): give a mesh that changes often a scene of its own and instance it.
+ * builds one tree over all of a scene's own meshes until one of them is
+ * updated; from that commit on (a one-time rebuild) the scene keeps a tree
+ * per mesh, and an update refits only that mesh's (0.2 ms for a box beside a
+ * 1M-triangle mesh, against 0.2 s to rebuild both before).
  * The vertices are checked again as rc_scene_add_mesh checks them. */
 RC_API rc_status rc_scene_update_mesh(rc_scene *scene, uint32_t geom_id);
 

@@ -86,7 +86,9 @@ typedef struct rc__emb_geom {
  * in mesh_scene, placed in the top scene by one identity instance (id
  * mesh_inst_id): a commit that only moved instances then rebuilds the top
  * scene over the instances, not Embree's tree over every triangle of the map.
- * Instancing such a scene instances its mesh_scene. */
+ * Instancing such a scene instances its mesh_scene. Once one of its meshes
+ * has been updated (rc_scene_update_mesh) the scene holding the meshes builds
+ * in two levels (dynamic; embree_scene.c, mesh_scene_settings). */
 typedef struct rc__emb_scene {
     RTCScene scene;             /* what rays are traced against */
     uint32_t max_geoms;
@@ -96,6 +98,8 @@ typedef struct rc__emb_scene {
     RTCScene mesh_scene;        /* the own meshes when split, else NULL (they are in scene) */
     RTCGeometry mesh_inst;      /* scene's identity instance of mesh_scene (once it has meshes) */
     uint32_t mesh_inst_id;      /* max_geoms + max_insts */
+    uint32_t dynamic;           /* 1 once a mesh was updated: the meshes' scene builds in two levels */
+    uint32_t unfinished;        /* 1 while a commit has not completed (it failed, or runs) */
     uint32_t reserved0;
 } rc__emb_scene;
 

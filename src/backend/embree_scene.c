@@ -236,6 +236,22 @@ static enum RTCSceneFlags scene_flags(const rc__emb_device *d, const rc_scene *s
     return (enum RTCSceneFlags)flags;
 }
 
+/* Flags and build quality of the Embree scene that holds the meshes. Once a
+ * mesh has been updated (es->dynamic) it builds in two levels: a tree per
+ * mesh, kept across commits, and a small tree over the meshes. Embree takes
+ * its two-level builder for RTC_BUILD_QUALITY_LOW scenes; each mesh's own
+ * tree still builds with the geometry's quality (quality_of), and an updated
+ * mesh's is refitted (geometry_update). Otherwise one tree over all the
+ * meshes' triangles traces faster, but updating any mesh rebuilds it whole. */
+static void mesh_scene_settings(const rc__emb_device *d, const rc__emb_scene *es, const rc_scene *scene,
+                                RTCScene s)
+{
+    int flags = (int)scene_flags(d, scene);
+    if (es->dynamic) flags |= RTC_SCENE_FLAG_DYNAMIC;
+    rtcSetSceneFlags(s, (enum RTCSceneFlags)flags);
+    rtcSetSceneBuildQuality(s, es->dynamic ? RTC_BUILD_QUALITY_LOW : quality_of(scene));
+}
+
 static rc_status geometry_create(rc__emb_device *d, rc__emb_scene *es, const rc_scene *scene, uint32_t gi)
 {
     const rc__mesh *m = &scene->geoms[gi].mesh;
@@ -283,6 +299,9 @@ static rc_status geometry_update(rc__emb_device *d, const rc_scene *scene, rc__e
         if (v) copy_vertices(&scene->geoms[gi].mesh, v);
     }
     rtcUpdateGeometryBuffer(g->geom, RTC_BUFFER_TYPE_VERTEX, 0);
+    /* same triangles, moved vertices: refit this mesh's tree (two-level
+     * scenes, mesh_scene_settings) */
+    rtcSetGeometryBuildQuality(g->geom, RTC_BUILD_QUALITY_REFIT);
     rtcCommitGeometry(g->geom);
     g->dups_done = 0;
     return rc__emb_check(d, "rc_scene_commit (mesh update)");
@@ -438,12 +457,23 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
      * here came through the error callback between calls. */
     RC_TRY(rc__emb_check(d, "rc_scene_commit (pending)"));
     RC_TRY(scene_state(d, scene, &es));
-    rtcSetSceneFlags(es->scene, scene_flags(d, scene));
-    rtcSetSceneBuildQuality(es->scene, quality_of(scene));
-    if (es->mesh_scene) {
-        rtcSetSceneFlags(es->mesh_scene, scene_flags(d, scene));
-        rtcSetSceneBuildQuality(es->mesh_scene, quality_of(scene));
+    for (i = 0; i < scene->geom_count; ++i) es->dynamic |= es->geoms[i].geom != NULL && scene->geoms[i].dirty == 2;
+    if (es->unfinished) {
+        /* Embree 3.13's two-level build, stopped part way (a refused
+         * allocation), keeps the meshes it had not finished as if built and
+         * crashes on them next time: every mesh builds afresh */
+        for (i = 0; i < scene->geom_count; ++i)
+            if (es->geoms[i].geom) {
+                rtcDetachGeometry(rc__emb_mesh_scene(es), i);
+                rtcAttachGeometryByID(rc__emb_mesh_scene(es), es->geoms[i].geom, i);
+            }
     }
+    es->unfinished = 1;
+    if (es->mesh_scene) {
+        rtcSetSceneFlags(es->scene, scene_flags(d, scene));
+        rtcSetSceneBuildQuality(es->scene, quality_of(scene));
+    }
+    mesh_scene_settings(d, es, scene, rc__emb_mesh_scene(es));
     for (i = 0; i < scene->geom_count; ++i) {
         rc__geometry *geo = &scene->geoms[i];
         rc__emb_geom *g = &es->geoms[i];
@@ -478,6 +508,7 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
     scene->bounds.max[2] = b.upper_z;
     for (i = 0; i < scene->geom_count; ++i) scene->geoms[i].dirty = 0;
     scene->top_dirty = 0;
+    es->unfinished = 0;
     if (progress) progress(user, "commit", 1.0);
     return RC_OK;
 }
