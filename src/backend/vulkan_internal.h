@@ -52,6 +52,7 @@ typedef struct rc__vk_span {
     unsigned char *chunk[RC__VK_MAX_CHUNKS];
     uint32_t shift;
     uint32_t elem_size;
+    uint64_t base;  /* the element chunk[0] starts at (0: the whole array; a staged section: its first) */
 } rc__vk_span;
 
 typedef struct rc__vk_pack_dst {
@@ -240,12 +241,25 @@ const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
 void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info);
 /* Writes them (after rc__vk_pack_count with the same serial). */
 void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
-/* Writes again, into arrays packed before with the same layout, only the
- * meshes that changed (own geometry g where changed[g]; every mesh of an
- * instanced source re-committed since the scene's last commit), then the
- * instance records and the top level (after rc__vk_pack_count with serial). */
-void rc__vk_pack_refill(rc_scene *scene, uint32_t serial, const uint8_t *changed, const rc__vk_pack_info *info,
-                        const rc__vk_pack_dst *dst);
+/* One mesh's place in the packed arrays: the first element of each of its
+ * sections and their lengths (nodes from where the cursor stood, so a
+ * padding node before its pair-aligned start is included). */
+typedef struct rc__vk_section {
+    const rc__mesh *mesh;
+    uint32_t geom_id;   /* within its own scene */
+    uint32_t reserved0;
+    uint64_t geom;      /* its geometry record */
+    uint64_t node, nodes, ref, refs, tri, tris, vert, verts;
+} rc__vk_section;
+/* The meshes a commit that keeps the layout must write again: own geometry g
+ * where changed[g], and every mesh of an instanced source re-committed since
+ * the scene's last commit (after rc__vk_pack_count with serial). Fills up to
+ * max of them into out and returns how many there are. */
+uint32_t rc__vk_pack_changed(rc_scene *scene, uint32_t serial, const uint8_t *changed, rc__vk_section *out,
+                             uint32_t max);
+/* Writes one mesh's sections (its padding node, geometry record, nodes, refs,
+ * triangles and vertices) into dst, as rc__vk_pack_fill writes them. */
+void rc__vk_pack_section(const rc__vk_section *s, const rc__vk_pack_dst *dst);
 /* Writes only what a commit that moved instances changes: the instance
  * records and the top level's nodes and refs (after rc__vk_pack_count). */
 void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);

@@ -23,6 +23,7 @@ static void span_write(const rc__vk_span *s, uint64_t first, const void *src, ui
 {
     const unsigned char *p = (const unsigned char *)src;
     const uint64_t per = (uint64_t)1 << s->shift;
+    first -= s->base;
     while (count) {
         const uint64_t c = first >> s->shift, off = first & (per - 1u);
         const uint64_t room = per - off, n = count < room ? count : room;
@@ -172,18 +173,36 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
     rc__vk_pack_fill_top(scene, info, dst);
 }
 
-void rc__vk_pack_refill(rc_scene *scene, uint32_t serial, const uint8_t *changed, const rc__vk_pack_info *info,
-                        const rc__vk_pack_dst *dst)
+/* Appends m's section at cursor c to out (while there is room) and moves c past it. */
+static void note_section(const rc__mesh *m, uint32_t geom_id, int write, pack_cursor *c, rc__vk_section *out,
+                         uint32_t max, uint32_t *n)
+{
+    if (write && *n < max) {
+        rc__vk_section *s = &out[*n];
+        s->mesh = m;
+        s->geom_id = geom_id;
+        s->reserved0 = 0;
+        s->geom = c->geom;
+        s->node = c->node;
+        s->nodes = pair_aligned(c->node) + m->bvh.node_count - c->node;
+        s->ref = c->ref;
+        s->refs = m->bvh.item_count;
+        s->tri = c->tri;
+        s->tris = m->triangle_count;
+        s->vert = c->vert;
+        s->verts = m->vertex_count;
+    }
+    *n += write ? 1u : 0u;
+    skip_mesh(m, c);
+}
+
+uint32_t rc__vk_pack_changed(rc_scene *scene, uint32_t serial, const uint8_t *changed, rc__vk_section *out,
+                             uint32_t max)
 {
     pack_cursor c;
-    uint32_t g, i;
+    uint32_t g, i, n = 0;
     memset(&c, 0, sizeof c);
-    for (g = 0; g < scene->geom_count; ++g) {
-        if (changed[g])
-            fill_mesh(&scene->geoms[g].mesh, g, dst, &c);
-        else
-            skip_mesh(&scene->geoms[g].mesh, &c);
-    }
+    for (g = 0; g < scene->geom_count; ++g) note_section(&scene->geoms[g].mesh, g, changed[g] != 0, &c, out, max, &n);
     for (i = 0; i < scene->inst_count; ++i) {
         const rc_scene *source = scene->insts[i].source;
         rc__vk_scene *sv = vk_scene_of(source);
@@ -191,14 +210,20 @@ void rc__vk_pack_refill(rc_scene *scene, uint32_t serial, const uint8_t *changed
         const int moved = source->version != scene->source_versions[i];
         if (sv->fill_serial == serial) continue;
         sv->fill_serial = serial;
-        for (g = 0; g < source->geom_count; ++g) {
-            if (moved)
-                fill_mesh(&source->geoms[g].mesh, g, dst, &c);
-            else
-                skip_mesh(&source->geoms[g].mesh, &c);
-        }
+        for (g = 0; g < source->geom_count; ++g) note_section(&source->geoms[g].mesh, g, moved, &c, out, max, &n);
     }
-    rc__vk_pack_fill_top(scene, info, dst);
+    return n;
+}
+
+void rc__vk_pack_section(const rc__vk_section *s, const rc__vk_pack_dst *dst)
+{
+    pack_cursor c;
+    c.node = s->node;
+    c.ref = s->ref;
+    c.tri = s->tri;
+    c.vert = s->vert;
+    c.geom = s->geom;
+    fill_mesh(s->mesh, s->geom_id, dst, &c);
 }
 
 void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst)

@@ -15,8 +15,9 @@
  * a few moving objects, maybe a mesh updated in place) keeps the buffers:
  * after moving instances it rewrites the instance records and the top level
  * and rebuilds only the top-level acceleration structure (its cost is the
- * instances', not the map's); where device memory is mapped it also rewrites
- * the sections of the meshes that changed.
+ * instances', not the map's); it also rewrites the sections of the meshes
+ * that changed, directly where device memory is mapped and through a staging
+ * buffer sized to them where it is not.
  * Arena use: the rc__vk_scene record plus the BVH (rc__scene_bvh_commit_bytes). */
 #include "backend/vulkan_internal.h"
 
@@ -147,22 +148,87 @@ static rc_status copy_chunked(rc__vk_state *st, const rc__vk_buffer *staging, Vk
     return RC_OK;
 }
 
-/* A commit that keeps the packed layout, in place: with changed NULL (no
- * mesh changed) the instance records and the top level rewritten, the rest
- * of the device arrays (and, for ray query, the bottom levels) kept; with
- * changed (mapped device memory only) the changed meshes' sections too, and
- * the ray query structures built again. *done 0 when the layout differs
- * after all (the caller uploads everything). */
+/* Upper bound of the meshes rc__vk_pack_changed can name (a source
+ * instanced twice counts twice). */
+static uint32_t sections_bound(const rc_scene *scene)
+{
+    uint32_t i, n = scene->geom_count;
+    for (i = 0; i < scene->inst_count; ++i) n += scene->insts[i].source->geom_count;
+    return n;
+}
+
+static uint64_t align16(uint64_t n) { return (n + 15u) & ~(uint64_t)15u; }
+
+/* Staging bytes for one mesh's sections, each 16-aligned. */
+static uint64_t section_bytes(const rc__vk_section *m)
+{
+    return align16(sizeof(rc__vk_geom)) + align16(m->nodes * sizeof(rc__bvh_node)) + align16(m->refs * 4u) +
+           align16(m->tris * 12u) + align16(m->verts * 12u);
+}
+
+/* A span over one section of an array, at off in the staging buffer. */
+static rc__vk_span span_section(const rc__vk_buffer *staging, uint64_t off, uint64_t first, uint32_t elem_size)
+{
+    rc__vk_span sp;
+    memset(&sp, 0, sizeof sp);
+    sp.chunk[0] = (unsigned char *)staging->map + off;
+    sp.shift = 62u; /* one chunk */
+    sp.elem_size = elem_size;
+    sp.base = first;
+    return sp;
+}
+
+/* Writes the meshes' sections into staging at *off and copies them into the
+ * device arrays (discrete GPUs: only what changed crosses the bus). */
+static rc_status stage_sections(rc__vk_state *st, rc__vk_scene *sv, const rc__vk_section *m, uint32_t n,
+                                const rc__vk_buffer *staging, uint64_t off)
+{
+    uint32_t k;
+    rc_status s = RC_OK;
+    for (k = 0; k < n && s == RC_OK; ++k) {
+        const uint64_t o_geom = off, o_node = o_geom + align16(sizeof(rc__vk_geom));
+        const uint64_t o_ref = o_node + align16(m[k].nodes * sizeof(rc__bvh_node));
+        const uint64_t o_tri = o_ref + align16(m[k].refs * 4u), o_vert = o_tri + align16(m[k].tris * 12u);
+        rc__vk_pack_dst dst;
+        memset(&dst, 0, sizeof dst);
+        dst.geoms = span_section(staging, o_geom, m[k].geom, (uint32_t)sizeof(rc__vk_geom));
+        dst.nodes = span_section(staging, o_node, m[k].node, (uint32_t)sizeof(rc__bvh_node));
+        dst.refs = span_section(staging, o_ref, m[k].ref, 4u);
+        dst.tris = span_section(staging, o_tri, m[k].tri, 12u);
+        dst.verts = span_section(staging, o_vert, m[k].vert, 12u);
+        rc__vk_pack_section(&m[k], &dst);
+        s = rc__vk_copy_region(st, staging, &sv->geoms, o_geom, m[k].geom * sizeof(rc__vk_geom),
+                               sizeof(rc__vk_geom));
+        if (s == RC_OK && m[k].nodes)
+            s = copy_chunked(st, staging, o_node, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node), m[k].node,
+                             m[k].nodes);
+        if (s == RC_OK && m[k].refs) s = rc__vk_copy_region(st, staging, &sv->refs, o_ref, m[k].ref * 4u, m[k].refs * 4u);
+        if (s == RC_OK && m[k].tris) s = copy_chunked(st, staging, o_tri, sv->tris, st->tri_shift, 12u, m[k].tri, m[k].tris);
+        if (s == RC_OK && m[k].verts)
+            s = copy_chunked(st, staging, o_vert, sv->verts, st->vert_shift, 12u, m[k].vert, m[k].verts);
+        off += section_bytes(&m[k]);
+    }
+    return s;
+}
+
+/* A commit that keeps the packed layout, in place: the instance records and
+ * the top level rewritten, and with changed (not NULL) the sections of the
+ * meshes that changed too (and, for ray query, the structures built again);
+ * the rest of the device arrays (and the bottom levels) kept. Mapped device
+ * memory is written directly; otherwise what changes goes through one
+ * staging buffer and region copies. *done 0 when the layout differs after
+ * all (the caller uploads everything). */
 static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene *sv, const uint8_t *changed,
                                  int *done)
 {
     rc__vk_pack_info info;
     rc__vk_pack_dst dst;
     rc__vk_buffer staging;
+    rc__vk_section *meshes = NULL;
     const uint64_t inst_bytes = (uint64_t)scene->inst_count * sizeof(rc__vk_inst);
     const uint64_t node_bytes = (uint64_t)scene->top.node_count * sizeof(rc__bvh_node);
     const uint64_t ref_bytes = (uint64_t)scene->top.item_count * 4u;
-    uint32_t serial, c;
+    uint32_t serial, c, n = 0, k;
     rc_status s = RC_OK;
     *done = 0;
     if (++st->serial == 0) ++st->serial;
@@ -170,6 +236,13 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
     rc__vk_pack_count(scene, serial, &info);
     if (memcmp(&info, &sv->info, sizeof info) != 0) return RC_OK;
     *done = 1;
+    if (changed) {
+        const uint32_t bound = sections_bound(scene);
+        meshes = (rc__vk_section *)rc__vk_host_alloc(st, (size_t)(bound ? bound : 1u) * sizeof *meshes);
+        RC_RETURN_IF(st->ctx, meshes == NULL, RC_ERR_OUT_OF_MEMORY,
+                     "rc_scene_commit: no host memory for the Vulkan commit's list of %u meshes", (unsigned)bound);
+        n = rc__vk_pack_changed(scene, serial, changed, meshes, bound);
+    }
     memset(&dst, 0, sizeof dst);
     if (st->device_mappable) {
         dst.nodes = span_over(sv->nodes, sv->node_chunks, st->node_shift, (uint32_t)sizeof(rc__bvh_node));
@@ -178,38 +251,44 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
         dst.refs = span_over(&sv->refs, 1, 31u, 4u);
         dst.geoms = span_over(&sv->geoms, 1, 31u, (uint32_t)sizeof(rc__vk_geom));
         dst.insts = span_over(&sv->insts, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
-        if (changed)
-            rc__vk_pack_refill(scene, serial, changed, &info, &dst);
-        else
-            rc__vk_pack_fill_top(scene, &info, &dst);
+        for (k = 0; k < n; ++k) rc__vk_pack_section(&meshes[k], &dst);
+        rc__vk_pack_fill_top(scene, &info, &dst);
         for (c = 0; c < RC__VK_MAX_CHUNKS && s == RC_OK; ++c) {
             if (c < sv->node_chunks) s = rc__vk_buffer_flush(st, &sv->nodes[c]);
-            if (s == RC_OK && changed && c < sv->tri_chunks) s = rc__vk_buffer_flush(st, &sv->tris[c]);
-            if (s == RC_OK && changed && c < sv->vert_chunks) s = rc__vk_buffer_flush(st, &sv->verts[c]);
+            if (s == RC_OK && n && c < sv->tri_chunks) s = rc__vk_buffer_flush(st, &sv->tris[c]);
+            if (s == RC_OK && n && c < sv->vert_chunks) s = rc__vk_buffer_flush(st, &sv->verts[c]);
         }
         if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->refs);
         if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->geoms);
         if (s == RC_OK) s = rc__vk_buffer_flush(st, &sv->insts);
     } else {
-        /* staged: records, nodes and refs one after another, then copied */
+        /* staged: records, top nodes and refs one after another, then the
+         * changed meshes' sections, then copied */
         const uint64_t node_off = (inst_bytes + 31u) & ~(uint64_t)31u, ref_off = node_off + node_bytes;
-        RC_TRY(rc__vk_buffer_create(st, ref_off + ref_bytes, RC__VK_MEM_UPLOAD, "upload staging", &staging));
-        dst.insts = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
-        dst.nodes = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__bvh_node));
-        dst.refs = span_over(&staging, 1, 31u, 4u);
-        /* the top level at the start of its staging section, not at its index */
-        info.top_node = (uint32_t)(node_off / sizeof(rc__bvh_node));
-        info.top_ref = (uint32_t)(ref_off / 4u);
-        rc__vk_pack_fill_top(scene, &info, &dst);
-        if (inst_bytes) s = rc__vk_copy_region(st, &staging, &sv->insts, 0, 0, inst_bytes);
-        if (s == RC_OK)
-            s = copy_chunked(st, &staging, node_off, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node),
-                             sv->info.top_node, scene->top.node_count);
-        if (s == RC_OK && ref_bytes) /* a copy of 0 bytes is not valid Vulkan */
-            s = rc__vk_copy_region(st, &staging, &sv->refs, ref_off, (uint64_t)sv->info.top_ref * 4u,
-                                   ref_bytes);
-        rc__vk_buffer_destroy(st, &staging);
+        uint64_t bytes = align16(ref_off + ref_bytes);
+        const uint64_t mesh_off = bytes;
+        for (k = 0; k < n; ++k) bytes += section_bytes(&meshes[k]);
+        s = rc__vk_buffer_create(st, bytes, RC__VK_MEM_UPLOAD, "upload staging", &staging);
+        if (s == RC_OK) {
+            dst.insts = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__vk_inst));
+            dst.nodes = span_over(&staging, 1, 31u, (uint32_t)sizeof(rc__bvh_node));
+            dst.refs = span_over(&staging, 1, 31u, 4u);
+            /* the top level at the start of its staging section, not at its index */
+            info.top_node = (uint32_t)(node_off / sizeof(rc__bvh_node));
+            info.top_ref = (uint32_t)(ref_off / 4u);
+            rc__vk_pack_fill_top(scene, &info, &dst);
+            s = stage_sections(st, sv, meshes, n, &staging, mesh_off);
+            if (s == RC_OK && inst_bytes) s = rc__vk_copy_region(st, &staging, &sv->insts, 0, 0, inst_bytes);
+            if (s == RC_OK)
+                s = copy_chunked(st, &staging, node_off, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node),
+                                 sv->info.top_node, scene->top.node_count);
+            if (s == RC_OK && ref_bytes) /* a copy of 0 bytes is not valid Vulkan */
+                s = rc__vk_copy_region(st, &staging, &sv->refs, ref_off, (uint64_t)sv->info.top_ref * 4u,
+                                       ref_bytes);
+            rc__vk_buffer_destroy(st, &staging);
+        }
     }
+    rc__vk_host_free(st, meshes);
     if (s == RC_OK && st->ray_query)
         s = changed ? rc__vk_accel_build(scene, serial) : rc__vk_accel_update_top(scene, serial);
     return s;
@@ -242,9 +321,9 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
         int in_place = layout_kept(scene, sv), changed_meshes = 0, done = 0;
         uint8_t *changed = in_place ? (uint8_t *)rc__vk_host_alloc(st, scene->geom_count + 1u) : NULL;
         if (changed) changed_meshes = meshes_changed(scene, changed);
-        /* changed meshes are rewritten in place where device memory is mapped
-         * (UMA boards, lavapipe); staged, they go up with everything else */
-        in_place = changed != NULL && (!changed_meshes || st->device_mappable);
+        /* what changed is rewritten in place: directly where device memory
+         * is mapped (UMA boards, lavapipe), else through staging */
+        in_place = changed != NULL;
         sv->current = 0; /* until this commit succeeds */
         s = rc__scene_build_bvh(scene, progress, user);
         if (s == RC_OK && in_place) {
