@@ -178,7 +178,7 @@ static rc__vk_span span_section(const rc__vk_buffer *staging, uint64_t off, uint
     return sp;
 }
 
-/* Writes the meshes' sections into staging at *off and copies them into the
+/* Writes the meshes' sections into staging from off on and copies them into the
  * device arrays (discrete GPUs: only what changed crosses the bus). */
 static rc_status stage_sections(rc__vk_state *st, rc__vk_scene *sv, const rc__vk_section *m, uint32_t n,
                                 const rc__vk_buffer *staging, uint64_t off)
