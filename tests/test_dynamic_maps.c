@@ -3,8 +3,10 @@
  * place) and, in half the rounds, two instances of an object scene. Random
  * sequences of what a robot does between scans (move the door and
  * rc_scene_update_mesh, move an instance, update the object's mesh and commit
- * its scene again), mixed with refused steps (a NaN vertex, a NaN pose, and on
- * Embree a commit refused by its memory budget), run on both contexts; after
+ * its scene again), mixed with refused steps (a NaN vertex, a NaN pose, and a
+ * commit squeezed by the backend's memory budget: Embree's allocations, or
+ * Vulkan's device memory, which an in-place commit needs only when its uploads
+ * are staged), run on both contexts; after
  * every commit both scan the same poses and must agree: the same hit flags
  * (but for a ray or two grazing an edge), and where they name the same
  * triangle the same range within 1e-5 relative. Each step keeps whatever
@@ -20,12 +22,15 @@
 #if defined(RANGECAST_WITH_EMBREE)
 #include "backend/embree_internal.h"
 #endif
+#if defined(RANGECAST_WITH_VULKAN)
+#include "backend/vulkan_internal.h"
+#endif
 
 #define POSES 2u
 #define RAYS (16u * 900u)
 
 static uint64_t rng;
-static uint32_t refused; /* squeezed commits Embree refused */
+static uint32_t refused; /* squeezed commits the backend refused */
 static const char *const op_names[5] = {"door moved", "instance moved", "object changed", "refused steps",
                                         "door moved, commit squeezed"};
 static double uniform(double lo, double hi)
@@ -139,35 +144,56 @@ static uint32_t compare_scans(side sides[2], unsigned long seed, uint32_t step, 
     return moved;
 }
 
+/* Caps what the backend may hold outside the arena at what it holds now plus
+ * extra bytes (Embree's allocations, Vulkan's device memory); extra 0 lifts
+ * the cap. 0 when the backend has no cap to set. */
+static int squeeze_budget(rc_context *ctx, uint32_t backend, uint64_t extra)
+{
+#if defined(RANGECAST_WITH_EMBREE)
+    if (backend == RC_BACKEND_EMBREE) {
+        rc__embree_options *opt = rc__embree_options_of(ctx);
+        rc_memory_stats ms = rc_memory_stats_default();
+        RCT_OK(ctx, rc_context_get_memory_stats(ctx, &ms));
+        opt->budget_bytes = extra ? ms.backend_bytes + extra : 0u;
+        return 1;
+    }
+#endif
+#if defined(RANGECAST_WITH_VULKAN)
+    if (backend == RC_BACKEND_VULKAN) {
+        rc__vk_state *st = rc__vk(ctx);
+        st->budget_bytes = extra ? st->device_bytes + extra : 0u;
+        return 1;
+    }
+#endif
+    (void)ctx;
+    (void)backend;
+    (void)extra;
+    return 0;
+}
+
 /* Commits the world on both sides; a refused commit must leave nothing to
- * simulate. A squeezed Embree budget may refuse it (and is then lifted). */
-static void commit_both(side sides[2], int squeeze, unsigned long seed, uint32_t step)
+ * simulate. With squeeze, the backend's budget is capped for the commit
+ * (Embree or Vulkan may then refuse it: out of memory, the scene
+ * uncommitted) and lifted again, and the commit repeated. */
+static void commit_both(side sides[2], uint32_t backend, int squeeze, unsigned long seed, uint32_t step)
 {
     rc_status st;
     RCT_OK(sides[0].ctx, rc_scene_commit(sides[0].world));
-#if defined(RANGECAST_WITH_EMBREE)
-    if (squeeze) {
-        rc__embree_options *opt = rc__embree_options_of(sides[1].ctx);
-        rc_memory_stats ms = rc_memory_stats_default();
-        RCT_OK(sides[1].ctx, rc_context_get_memory_stats(sides[1].ctx, &ms));
-        opt->budget_bytes = ms.backend_bytes + (uint64_t)uniform(1024.0, 65536.0);
+    /* from 1 byte to 64 KiB of room, evenly in log scale */
+    if (squeeze && squeeze_budget(sides[1].ctx, backend, (uint64_t)exp(uniform(0.0, 11.09)))) {
         st = rc_scene_commit(sides[1].world);
-        opt->budget_bytes = 0;
-        if (st != RC_OK) {
-            ++refused;
-            if (st != RC_ERR_OUT_OF_MEMORY)
-                fail_msg("seed %lu step %u: squeezed commit gave %s (%s)", seed, step, rc_status_string(st),
-                         rc_context_last_error(sides[1].ctx));
+        (void)squeeze_budget(sides[1].ctx, backend, 0u);
+        if (st == RC_OK) return;
+        ++refused;
+        if (st != RC_ERR_OUT_OF_MEMORY)
+            fail_msg("seed %lu step %u: squeezed commit gave %s (%s)", seed, step, rc_status_string(st),
+                     rc_context_last_error(sides[1].ctx));
+        {
             const rc_pose at = rct_pose(0.0f, 0.0f, 0.0f);
             assert_int_equal(rc_simulate(sides[1].ctx, sides[1].world, sides[1].lidar, &at, 1, &sides[1].out.res),
                              RC_ERR_NOT_COMMITTED);
-        } else {
-            return;
         }
     }
-#else
-    (void)squeeze;
-#endif
     st = rc_scene_commit(sides[1].world);
     if (st != RC_OK)
         fail_msg("seed %lu step %u: commit gave %s (%s)", seed, step, rc_status_string(st),
@@ -224,12 +250,12 @@ static void one_round(uint32_t backend, unsigned long seed, uint32_t *moved)
                     assert_int_not_equal(rc_scene_set_instance_transform(sides[b].world, 0, &bad, NULL), RC_OK);
             /* and a real update, so the commit below has work */
             for (b = 0; b < 2; ++b) RCT_OK(sides[b].ctx, rc_scene_update_mesh(sides[b].world, 1));
-        } else { /* Embree: the commit after a door move squeezed by the budget */
+        } else { /* the commit after a door move squeezed by the backend's budget */
             place_box(&w.door, w.door_v);
             for (b = 0; b < 2; ++b) RCT_OK(sides[b].ctx, rc_scene_update_mesh(sides[b].world, 1));
-            squeeze = backend == RC_BACKEND_EMBREE;
+            squeeze = 1;
         }
-        commit_both(sides, squeeze, seed, step);
+        commit_both(sides, backend, squeeze, seed, step);
         *moved += compare_scans(sides, seed, step, op_names[op]);
     }
     side_close(&sides[1]);
@@ -251,7 +277,7 @@ static void run_backend(uint32_t backend)
     print_message("%lu rounds on %s: %u ray hits on what moved, %u commits refused by the budget\n", rounds,
                   rc_backend_name(backend), moved, refused);
     assert_true(moved > 1000u); /* the scans looked at the door and the instances */
-    if (backend == RC_BACKEND_EMBREE) assert_true(refused > 0u); /* and Embree went through refused commits */
+    if (backend == RC_BACKEND_EMBREE) assert_true(refused > 0u); /* and went through refused commits */
 }
 
 static void test_dynamic_embree(void **state)
