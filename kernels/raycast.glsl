@@ -60,7 +60,7 @@ layout(push_constant) uniform PC {
     uint top_node;    /* node index of the top-level root */
     uint top_ref;     /* ref index of the top level's refs */
     uint groups_x;    /* workgroups per row of the 2D dispatch */
-    uint flags;       /* bit 0: one mesh, no instances: skip the top level */
+    uint flags;       /* bit 0: one mesh, no instances: skip the top level; bit 31 never set (f32) */
     uint off_hits, off_ranges, off_points, off_normals, off_prim, off_geom, off_inst;
     /* range noise of results kept on the device (noise.glsl) */
     uint noise_key_lo, noise_key_hi;   /* rc__noise_key(seed, draw) */
@@ -72,6 +72,7 @@ layout(push_constant) uniform PC {
 #define NOISE_ON 1u
 #define NOISE_MOVES 2u
 #define NOISE_DROPS 4u
+#define RC_FLAGS_NEVER_SET 0x80000000u /* RC__VK_FLAGS_NEVER_SET */
 
 /* ---- chunked loads ------------------------------------------------------ */
 
@@ -556,6 +557,17 @@ float rayf(uint i) { return uintBitsToFloat(rays.r[i]); }
 #if RC_FP64
 double rayd(uint i) { return packDouble2x32(uvec2(rays.r[i], rays.r[i + 1u])); }
 
+/* float(x), and it stays rounded. glslang marks no conversion precise, so a
+ * driver may fold a later double(float(x)) back to x (Mesa 25's lavapipe
+ * does: every float64 refinement then started from unrounded directions, a
+ * float ulp off the host's ranges on 15% of the rays). The host never does;
+ * an OR with a zero the compiler cannot see (bit 31 of pc.flags, which the
+ * host never sets) keeps the rounding. */
+float f32(double x)
+{
+    return uintBitsToFloat(floatBitsToUint(float(x)) | (pc.flags & RC_FLAGS_NEVER_SET));
+}
+
 /* store_unit of sensor_rays.c: normalised in double, rounded to float */
 vec3 unit(double x, double y, double z)
 {
@@ -563,7 +575,7 @@ vec3 unit(double x, double y, double z)
     precise double ux = x / n;
     precise double uy = y / n;
     precise double uz = z / n;
-    return vec3(float(ux), float(uy), float(uz));
+    return vec3(f32(ux), f32(uy), f32(uz));
 }
 #else
 vec3 unit(float x, float y, float z)
@@ -709,7 +721,8 @@ float refine_t(Hit h, uint pose, vec3 ds, vec3 os)
     if (isinf(td) || isnan(td)) return h.t;
     /* the plane's distance is the better one; a non-positive value (origin
      * on the plane) keeps the traversal's t */
-    return td > 0.0lf && td < 3.0e38lf && float(td) > 0.0 ? float(td) : h.t;
+    /* f32: noise on the device widens the range to double again */
+    return td > 0.0lf && td < 3.0e38lf && float(td) > 0.0 ? f32(td) : h.t;
 }
 #else
 /* Without float64: the hit's distance against its triangle's plane in float,

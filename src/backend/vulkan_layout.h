@@ -50,6 +50,11 @@ typedef struct rc__vk_push {
     uint32_t noise_flags;   /* RC__VK_NOISE_* */
 } rc__vk_push;
 
+/* rc__vk_push.flags: bit 0 one mesh and no instances (rc__vk_pack_info.flags);
+ * bit 31 is never set: the kernel ORs it into values it must keep rounded to
+ * float (raycast.glsl, f32), a zero the shader compiler cannot fold away. */
+#define RC__VK_FLAGS_NEVER_SET 0x80000000u
+
 #define RC__VK_NOISE_ON 1u
 #define RC__VK_NOISE_MOVES 2u
 #define RC__VK_NOISE_DROPS 4u
