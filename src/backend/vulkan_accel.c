@@ -278,18 +278,47 @@ static uint32_t number_sources(rc_scene *scene, uint32_t serial)
     return n;
 }
 
-rc_status rc__vk_accel_update_top(rc_scene *scene, uint32_t serial)
+/* 1 when an own mesh changed (changed[g]). */
+static int own_changed(const rc_scene *scene, const uint8_t *changed)
+{
+    uint32_t g;
+    for (g = 0; g < scene->geom_count; ++g)
+        if (changed[g]) return 1;
+    return 0;
+}
+
+rc_status rc__vk_accel_update(rc_scene *scene, uint32_t serial, const uint8_t *changed)
 {
     rc__vk_state *st = rc__vk(scene->ctx);
     rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
-    rc_status s;
+    rc_status s = RC_OK;
+    uint32_t i;
     if (number_sources(scene, serial) != sv->blas_count || sv->blas_count == 0) {
         /* not the bottom levels of these sources: build them all, tagged afresh */
         if (++st->serial == 0) ++st->serial;
         return rc__vk_accel_build(scene, st->serial);
     }
-    accel_destroy(st, &sv->tlas);
-    s = build_top(st, scene, sv);
+    if (changed) {
+        /* the own meshes' bottom level when one of them changed, and each
+         * source's when it was committed again since the scene's last commit */
+        if (scene->geom_count > 0 && own_changed(scene, changed)) {
+            accel_destroy(st, &sv->blas[0]);
+            s = build_bottom(st, scene, &sv->blas[0]);
+        }
+        for (i = 0; i < scene->inst_count && s == RC_OK; ++i) {
+            const rc_scene *source = scene->insts[i].source;
+            rc__vk_scene *src = (rc__vk_scene *)source->backend_scene;
+            if (src->accel_serial != serial) continue; /* seen already */
+            src->accel_serial = serial - 1u;             /* once */
+            if (source->version == scene->source_versions[i]) continue;
+            accel_destroy(st, &sv->blas[src->pack_blas]);
+            s = build_bottom(st, source, &sv->blas[src->pack_blas]);
+        }
+    }
+    if (s == RC_OK) {
+        accel_destroy(st, &sv->tlas);
+        s = build_top(st, scene, sv);
+    }
     if (s != RC_OK) rc__vk_accel_release(st, sv);
     return s;
 }

@@ -290,8 +290,12 @@ size_t rc__vk_scene_commit_bytes(const rc_scene_desc *desc);
 /* Builds the scene's driver acceleration structures from its packed meshes
  * (after rc__vk_pack_count with serial tagged the instance sources). */
 rc_status rc__vk_accel_build(rc_scene *scene, uint32_t serial);
-/* Rebuilds only the top level over the same bottom levels (instances moved). */
-rc_status rc__vk_accel_update_top(rc_scene *scene, uint32_t serial);
+/* A commit that kept the packed layout: with changed NULL (instances moved)
+ * only the top level is built again; with changed (rc__vk_pack_changed's
+ * marks for own meshes) also the own meshes' bottom level when one of them
+ * changed and the bottom level of each source committed again since, the
+ * others kept. */
+rc_status rc__vk_accel_update(rc_scene *scene, uint32_t serial, const uint8_t *changed);
 void rc__vk_accel_release(rc__vk_state *st, rc__vk_scene *sv);
 
 /* vulkan_sensor.c --------------------------------------------------------- */

@@ -213,8 +213,8 @@ static rc_status stage_sections(rc__vk_state *st, rc__vk_scene *sv, const rc__vk
 
 /* A commit that keeps the packed layout, in place: the instance records and
  * the top level rewritten, and with changed (not NULL) the sections of the
- * meshes that changed too (and, for ray query, the structures built again);
- * the rest of the device arrays (and the bottom levels) kept. Mapped device
+ * meshes that changed too (and, for ray query, their bottom levels built
+ * again); the rest of the device arrays and bottom levels kept. Mapped device
  * memory is written directly; otherwise what changes goes through one
  * staging buffer and region copies. *done 0 when the layout differs after
  * all (the caller uploads everything). */
@@ -290,7 +290,7 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
     }
     rc__vk_host_free(st, meshes);
     if (s == RC_OK && st->ray_query)
-        s = changed ? rc__vk_accel_build(scene, serial) : rc__vk_accel_update_top(scene, serial);
+        s = rc__vk_accel_update(scene, serial, changed);
     return s;
 }
 
