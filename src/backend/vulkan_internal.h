@@ -247,7 +247,6 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
 typedef struct rc__vk_section {
     const rc__mesh *mesh;
     uint32_t geom_id;   /* within its own scene */
-    uint32_t reserved0;
     uint64_t geom;      /* its geometry record */
     uint64_t node, nodes, ref, refs, tri, tris, vert, verts;
 } rc__vk_section;

@@ -181,7 +181,6 @@ static void note_section(const rc__mesh *m, uint32_t geom_id, int write, pack_cu
         rc__vk_section *s = &out[*n];
         s->mesh = m;
         s->geom_id = geom_id;
-        s->reserved0 = 0;
         s->geom = c->geom;
         s->node = c->node;
         s->nodes = pair_aligned(c->node) + m->bvh.node_count - c->node;
