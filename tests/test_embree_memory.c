@@ -303,6 +303,29 @@ static void test_error_mapping(void **state)
     rcu_mesh_free(&m);
 }
 
+/* Adds m to scene as a referenced mesh over vertices (m's own, or a moved
+ * copy); returns its geometry id. */
+static uint32_t add_mesh(rc_context *ctx, rc_scene *scene, const rcu_mesh *m, const float *vertices)
+{
+    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t id;
+    md.vertices = vertices;
+    md.vertex_count = m->vertex_count;
+    md.indices = m->indices;
+    md.triangle_count = m->triangle_count;
+    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+    return id;
+}
+
+/* The dynamic-map tests' map (a 100k-triangle sphere of radius 20 m) and
+ * moving object (a unit box at the origin). */
+static void map_and_box(rcu_mesh *sphere, rcu_mesh *box)
+{
+    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
+    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000u, sphere), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, box), 0);
+}
+
 /* Asserts that out[0] (Embree) and out[1] (built-in) hold the same n rays:
  * hit flags, ranges within 1e-5 relative and the ids in ids0/ids1. Returns
  * how many hits have an id other than `other`. */
@@ -328,7 +351,6 @@ static uint32_t same_scans(const rct_buffers out[2], uint32_t n, const uint32_t 
  * match the built-in backend's. */
 static void test_moving_instances_keeps_the_map(void **state)
 {
-    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
     rcu_mesh sphere, box;
     rc_context *ctx[2];
     rc_scene *src[2], *world[2];
@@ -338,22 +360,16 @@ static void test_moving_instances_keeps_the_map(void **state)
     uint32_t b, i, id, n = 16u * 900u;
     (void)state;
     NEED_EMBREE();
-    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000u, &sphere), 0);
-    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    map_and_box(&sphere, &box);
     for (b = 0; b < 2; ++b) {
         rc_scene_desc sd = rc_scene_desc_default();
-        rc_mesh_desc md = rc_mesh_desc_default();
         ctx[b] = rct_context(b == 0 ? RC_BACKEND_EMBREE : RC_BACKEND_BVH, 2, 0);
         src[b] = rct_scene_mesh(ctx[b], &box, RC_MESH_REFERENCE);
         sd.max_geometries = 1;
         sd.max_instances = 3;
         sd.max_triangles = sphere.triangle_count;
         RCT_OK(ctx[b], rc_scene_create(ctx[b], &sd, &world[b]));
-        md.vertices = sphere.vertices;
-        md.vertex_count = sphere.vertex_count;
-        md.indices = sphere.indices;
-        md.triangle_count = sphere.triangle_count;
-        RCT_OK(ctx[b], rc_scene_add_mesh(world[b], &md, &id));
+        (void)add_mesh(ctx[b], world[b], &sphere, sphere.vertices);
         for (i = 0; i < 3; ++i) {
             rc_instance_desc in = rc_instance_desc_default();
             in.source = src[b];
@@ -402,7 +418,6 @@ static void test_moving_instances_keeps_the_map(void **state)
  * built-in backend's after every move. */
 static void test_updating_a_small_mesh_keeps_the_map(void **state)
 {
-    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
     rcu_mesh sphere, box;
     rc_context *ctx[2];
     rc_scene *world[2];
@@ -410,14 +425,12 @@ static void test_updating_a_small_mesh_keeps_the_map(void **state)
     rct_buffers out[2];
     float *moving[2];
     uint64_t before, first = 0, later = 0;
-    uint32_t b, i, id, step, seen = 0, n = 16u * 900u;
+    uint32_t b, i, step, seen = 0, n = 16u * 900u;
     (void)state;
     NEED_EMBREE();
-    assert_int_equal(rcu_mesh_uv_sphere_triangles(20.0f, 100000u, &sphere), 0);
-    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    map_and_box(&sphere, &box);
     for (b = 0; b < 2; ++b) {
         rc_scene_desc sd = rc_scene_desc_default();
-        rc_mesh_desc md = rc_mesh_desc_default();
         ctx[b] = rct_context(b == 0 ? RC_BACKEND_EMBREE : RC_BACKEND_BVH, 2, 0);
         moving[b] = (float *)malloc(sizeof(float) * 3u * box.vertex_count);
         assert_non_null(moving[b]);
@@ -425,17 +438,8 @@ static void test_updating_a_small_mesh_keeps_the_map(void **state)
         sd.max_geometries = 2;
         sd.max_triangles = sphere.triangle_count + box.triangle_count;
         RCT_OK(ctx[b], rc_scene_create(ctx[b], &sd, &world[b]));
-        md.vertices = sphere.vertices;
-        md.vertex_count = sphere.vertex_count;
-        md.indices = sphere.indices;
-        md.triangle_count = sphere.triangle_count;
-        RCT_OK(ctx[b], rc_scene_add_mesh(world[b], &md, &id));
-        md.vertices = moving[b];
-        md.vertex_count = box.vertex_count;
-        md.indices = box.indices;
-        md.triangle_count = box.triangle_count;
-        RCT_OK(ctx[b], rc_scene_add_mesh(world[b], &md, &id));
-        assert_int_equal(id, 1);
+        assert_int_equal(add_mesh(ctx[b], world[b], &sphere, sphere.vertices), 0);
+        assert_int_equal(add_mesh(ctx[b], world[b], &box, moving[b]), 1);
         RCT_OK(ctx[b], rc_scene_commit(world[b]));
         RCT_OK(ctx[b], rc_sensor_create_preset(ctx[b], RC_PRESET_VELODYNE_VLP16, &lidar[b]));
         rct_buffers_alloc(&out[b], n, RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_GEOM_IDS);
