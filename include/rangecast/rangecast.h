@@ -166,7 +166,9 @@ typedef struct rc_context rc_context;
 typedef struct rc_context_desc {
     uint32_t struct_size;   /* sizeof(rc_context_desc) */
     uint32_t backend;       /* RC_BACKEND_*; 0 = AUTO */
-    uint32_t thread_count;  /* 0 = number of online CPUs; 1 = run on the caller's thread */
+    uint32_t thread_count;  /* 0 = number of online CPUs; 1 = run on the caller's thread.
+                             * Any count: a call too small to split (a few rays, one
+                             * small scan) runs on the caller's thread alone. */
     uint32_t flags;         /* RC_CONTEXT_* below; 0 = defaults */
     /* The arena. memory != NULL: the caller's block of memory_size bytes,
      * aligned to 16 (RC_ARENA_ALIGNMENT); the library never calls malloc.

@@ -1,6 +1,9 @@
 /* Worker pool: workers sleep on a condition variable between runs; a run hands
  * out task indices under a mutex (tasks are coarse: a pose or a tile of rays,
- * so the lock is cheap). The calling thread works too. */
+ * so the lock is cheap). The calling thread works too, and a run ends when its
+ * tasks are done, not when every worker has woken: waking a sleeping thread
+ * takes tens of microseconds, which a small call (a few rays) must not wait
+ * for. A run of one task never wakes anyone. */
 #define _POSIX_C_SOURCE 200809L
 #include "core/threads.h"
 
@@ -20,12 +23,13 @@ struct rc__pool {
     uint64_t generation;     /* bumped per run */
     uint32_t next_task;
     uint32_t task_count;
-    uint32_t busy;           /* workers still inside the current run */
+    uint32_t done;           /* tasks of the current run finished */
     int shutdown;
     rc__task_fn fn;
     void *user;
     pthread_t *threads;      /* thread_count - 1 */
     uint32_t started;
+    uint32_t ready;          /* workers that have read their argument */
 #endif
 };
 
@@ -52,7 +56,10 @@ size_t rc__pool_memory(uint32_t thread_count)
 uint32_t rc__pool_thread_count(const rc__pool *pool) { return pool->thread_count; }
 
 #if defined(RANGECAST_WITH_THREADS)
-/* Takes tasks until none are left. Called with the lock held; returns with it held. */
+/* Takes tasks until none are left. Called with the lock held; returns with it
+ * held. A worker that wakes after its run has ended finds no task: fn and
+ * user are only read for a task taken while the run is still open, so the
+ * caller's run (and its stack) outlives every use of them. */
 static void drain(rc__pool *pool, uint32_t thread)
 {
     while (pool->next_task < pool->task_count) {
@@ -60,6 +67,7 @@ static void drain(rc__pool *pool, uint32_t thread)
         pthread_mutex_unlock(&pool->lock);
         pool->fn(pool->user, task, thread);
         pthread_mutex_lock(&pool->lock);
+        if (++pool->done == pool->task_count) pthread_cond_signal(&pool->idle);
     }
 }
 
@@ -74,12 +82,14 @@ static void *worker_main(void *arg)
     uint32_t index = ((worker_arg *)arg)->index;
     uint64_t seen = 0;
     pthread_mutex_lock(&pool->lock);
+    seen = pool->generation;
+    ++pool->ready;
+    pthread_cond_signal(&pool->idle); /* the creator waits for every worker */
     for (;;) {
         while (!pool->shutdown && pool->generation == seen) pthread_cond_wait(&pool->wake, &pool->lock);
         if (pool->shutdown) break;
         seen = pool->generation;
         drain(pool, index);
-        if (--pool->busy == 0) pthread_cond_signal(&pool->idle);
     }
     pthread_mutex_unlock(&pool->lock);
     return NULL;
@@ -112,8 +122,10 @@ rc_status rc__pool_create(rc__arena *arena, uint32_t thread_count, rc__pool **ou
             if (pthread_create(&pool->threads[i], NULL, worker_main, &args[i]) != 0) break;
             pool->started++;
         }
-        /* One empty run makes sure every worker has read its argument. */
-        rc__pool_run(pool, 0, NULL, NULL);
+        /* Every worker reads its argument before its first wait. */
+        pthread_mutex_lock(&pool->lock);
+        while (pool->ready < pool->started) pthread_cond_wait(&pool->idle, &pool->lock);
+        pthread_mutex_unlock(&pool->lock);
         if (pool->started + 1 != thread_count) {
             rc__pool_destroy(arena, pool);
             return RC_ERR_BACKEND;
@@ -129,17 +141,17 @@ rc_status rc__pool_create(rc__arena *arena, uint32_t thread_count, rc__pool **ou
 void rc__pool_run(rc__pool *pool, uint32_t task_count, rc__task_fn fn, void *user)
 {
 #if defined(RANGECAST_WITH_THREADS)
-    if (pool->thread_count > 1) {
+    if (pool->thread_count > 1 && task_count > 1) {
         pthread_mutex_lock(&pool->lock);
         pool->fn = fn;
         pool->user = user;
         pool->task_count = task_count;
         pool->next_task = 0;
-        pool->busy = pool->started;
+        pool->done = 0;
         pool->generation++;
         pthread_cond_broadcast(&pool->wake);
         drain(pool, 0);
-        while (pool->busy > 0) pthread_cond_wait(&pool->idle, &pool->lock);
+        while (pool->done < task_count) pthread_cond_wait(&pool->idle, &pool->lock);
         pthread_mutex_unlock(&pool->lock);
         return;
     }

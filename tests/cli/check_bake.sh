@@ -29,6 +29,12 @@ grep -Eq '"baked_map_bytes":null[,}]' out.txt || fail "bench on a PLY map: baked
 run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2 --ranges-out baked.f32 $BACKEND
 grep -Eq "\"baked_map_bytes\":$size[,}]" out.txt || { cat out.txt; fail "bench reports the baked map's bytes"; }
 cmp ply.f32 baked.f32 || fail "a baked map changed the ranges"
+# one pose a call (a robot's call) gives the same ranges as the batches
+run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2 --poses-per-call 1 \
+    --ranges-out one.f32 $BACKEND
+grep -Eq '"poses_per_call":1[,}]' out.txt || { cat out.txt; fail "bench reports poses_per_call 1"; }
+cmp ply.f32 one.f32 || fail "one pose a call changed the ranges"
+run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" bench --poses-per-call 0
 run 0 "" "$RC" bake --map sphere.ply --out again.rcmap --threads 1
 cmp sphere.rcmap again.rcmap || fail "two bakes of one map differ"
 # bench --help lists every key the JSON line has

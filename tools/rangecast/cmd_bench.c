@@ -21,7 +21,7 @@
 #define BENCH_SPHERE_RADIUS 20.0f  /* the standard workload (see ANCHORS.md) */
 #define BENCH_POSE_RADIUS   10.0f
 #define BENCH_TIMED_BYTES   ((size_t)128 << 20) /* ranges buffer of the timed loop ... */
-#define BENCH_TIMED_POSES   1000u                 /* ... and poses per rc_simulate call */
+#define BENCH_TIMED_POSES   1000u                 /* ... and poses per rc_simulate call (default) */
 #define BENCH_CHECK_BYTES   ((size_t)64 << 20)  /* buffers of the accuracy pass */
 /* --sensor random-ondn: incoherent OnDn rays, as many as a VLP-16 scan, with
  * origins in a ball about the sensor and VLP-16 ranges; a fixed layout (its
@@ -59,6 +59,8 @@ static void usage(FILE *f)
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
         "  --pose-count N     random poses without --poses (default 1000)\n"
+        "  --poses-per-call N poses an rc_simulate call of the timed loop takes (default 1000;\n"
+        "                     1 measures a robot's one-scan call, its latency 1 / scans_per_s)\n"
         "  --seed S           seed of the random poses (default 1)\n"
         "  --ranges-out FILE  write the ranges: float32 [pose][row][column], +inf no return\n"
         "  -h, --help         this text\n"
@@ -67,13 +69,14 @@ static void usage(FILE *f)
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
         "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
-        "build_quality baked_map_bytes vulkan_traversal.\n"
+        "build_quality baked_map_bytes vulkan_traversal poses_per_call.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
         "A baked map (.rcmap, rangecast bake) is loaded in place: build_s is then the load\n"
         "(rc_scene_load_baked), and the mesh and tree it holds are baked_map_bytes (null\n"
         "for other maps), outside the arena.\n"
-        "Timing: all poses, up to 1000 a call, ranges only, after a warm-up of 8 scans.\n"
+        "Timing: all poses, up to --poses-per-call a call (fewer when 128 MiB of ranges\n"
+        "would not hold them), ranges only, after a warm-up of 8 scans.\n"
         "Accuracy (untimed): each hit's range against the float64 distance from the\n"
         "pose's sensor origin along the float64 ray to the hit triangle's plane.\n"
         "hit_mismatch (sphere only, else null): rays the closed sphere must return\n"
@@ -181,6 +184,8 @@ static double inscribed_radius(const rcu_mesh *m)
 typedef struct bench_args {
     const char *map, *poses_path, *ranges_out;
     uint32_t preset, backend, threads, repeat, pose_count;
+    uint32_t poses_per_call; /* most poses an rc_simulate call of the timed loop takes */
+    int set_poses_per_call;
     uint64_t triangles, seed;
     const char *sensor_name;
     int set_triangles, set_pose_count, set_seed;
@@ -223,6 +228,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
     a->backend = RC_BACKEND_AUTO;
     a->repeat = 3;
     a->pose_count = 1000;
+    a->poses_per_call = BENCH_TIMED_POSES;
     a->triangles = 1000000;
     a->seed = 1;
     for (i = 1; i < argc; i++) {
@@ -294,6 +300,11 @@ static int parse_args(int argc, char **argv, bench_args *a)
             if (rcp_parse_u32(v, &a->pose_count) != 0 || a->pose_count == 0)
                 return rcp_usage_error(cmd, "--pose-count: expected a count >= 1, got '%s'", v), -1;
             a->set_pose_count = 1;
+        } else if (OPT("--poses-per-call")) {
+            if (r < 0) return -1;
+            if (rcp_parse_u32(v, &a->poses_per_call) != 0 || a->poses_per_call == 0)
+                return rcp_usage_error(cmd, "--poses-per-call: expected a count >= 1, got '%s'", v), -1;
+            a->set_poses_per_call = 1;
         } else if (OPT("--seed")) {
             if (r < 0) return -1;
             if (rcp_parse_count(v, &a->seed) != 0)
@@ -309,6 +320,9 @@ static int parse_args(int argc, char **argv, bench_args *a)
         fprintf(stderr, "rangecast bench: note: --triangles is ignored with --map\n");
     if (a->poses_path && (a->set_pose_count || a->set_seed))
         fprintf(stderr, "rangecast bench: note: --pose-count and --seed are ignored with --poses\n");
+    if (a->embree_single && a->set_poses_per_call)
+        fprintf(stderr, "rangecast bench: note: --poses-per-call is ignored with --backend embree-single "
+                        "(its loop makes no rc_simulate calls)\n");
     return 0;
 }
 
@@ -458,7 +472,7 @@ int rcp_cmd_bench(int argc, char **argv)
     /* ---- timed loop: ranges only, all poses in batches ---- */
     batch = (uint32_t)(BENCH_TIMED_BYTES / sizeof(float) / rays);
     if (batch == 0) batch = 1;
-    if (batch > BENCH_TIMED_POSES) batch = BENCH_TIMED_POSES;
+    if (batch > a.poses_per_call) batch = a.poses_per_call;
     if (batch > pose_count) batch = pose_count;
     ranges = (float *)malloc((size_t)batch * rays * sizeof(float));
     rep_s = (double *)malloc(a.repeat * sizeof(double));
@@ -687,10 +701,11 @@ int rcp_cmd_bench(int argc, char **argv)
         if (rcp_baked_of(&mesh)) printf("%llu", (unsigned long long)rcp_baked_of(&mesh)->bytes);
         else printf("null");
         if (w.backend == RC_BACKEND_VULKAN)
-            printf(",\"vulkan_traversal\":\"%s\"}\n",
+            printf(",\"vulkan_traversal\":\"%s\"",
                    (rcp_context_flags & RC_CONTEXT_VULKAN_RAY_QUERY) ? "ray-query" : "compute");
         else
-            printf(",\"vulkan_traversal\":null}\n");
+            printf(",\"vulkan_traversal\":null");
+        printf(",\"poses_per_call\":%u}\n", batch);
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;
