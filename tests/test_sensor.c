@@ -222,6 +222,87 @@ static void test_other_spherical_presets(void **state)
     assert_near(d.theta.increment, DEG(360.0 / 1024.0), 1e-7);
 }
 
+/* The 2-D scanner presets: one row at phi 0, columns in a ROS LaserScan's
+ * order, and ranges in a closed box room (-2..2 x -3..3 m) where each ray
+ * meets a wall at min(2 / |cos theta|, 3 / |sin theta|), or returns +inf past
+ * the LDS-01's 3.5 m (the room's corners are 3.6 m away). */
+static void check_scanner_in_room(rc_context *ctx, rc_sensor *s, double theta0_deg, double step_deg, uint32_t n,
+                                  double rmax)
+{
+    static const float v[8 * 3] = {-2, -3, -1, 2, -3, -1, 2, 3, -1, -2, 3, -1,
+                                   -2, -3, 1,  2, -3, 1,  2, 3, 1,  -2, 3, 1};
+    static const uint32_t idx[12 * 3] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
+                                         1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_mesh_desc md = rc_mesh_desc_default();
+    rc_results res = rc_results_default();
+    rc_pose pose = rc_pose_identity();
+    rc_scene *room = NULL;
+    float *ranges = (float *)malloc(sizeof(float) * n);
+    uint32_t geom, j, far = 0;
+    assert_non_null(ranges);
+    sd.max_triangles = 12;
+    md.vertices = v;
+    md.vertex_count = 8;
+    md.indices = idx;
+    md.triangle_count = 12;
+    assert_int_equal(rc_scene_create(ctx, &sd, &room), RC_OK);
+    assert_int_equal(rc_scene_add_mesh(room, &md, &geom), RC_OK);
+    assert_int_equal(rc_scene_commit(room), RC_OK);
+    res.attributes = RC_ATTR_RANGES;
+    res.ranges = ranges;
+    res.capacity = n;
+    assert_int_equal(rc_simulate(ctx, room, s, &pose, 1, &res), RC_OK);
+    for (j = 0; j < n; ++j) {
+        const double th = DEG(theta0_deg + step_deg * j), c = fabs(cos(th)), sn = fabs(sin(th));
+        const double want = fmin(c > 1e-12 ? 2.0 / c : INFINITY, sn > 1e-12 ? 3.0 / sn : INFINITY);
+        if (fabs(want - rmax) < 1e-3) continue; /* at range max either answer is right */
+        if (want > rmax) {
+            assert_true(isinf(ranges[j]) && ranges[j] > 0.0f);
+            ++far;
+        } else {
+            assert_near(ranges[j], want, 1e-5 * want);
+        }
+    }
+    if (rmax < 3.6) assert_true(far > 0); /* the corners are out of reach */
+    assert_int_equal(rc_scene_destroy(room), RC_OK);
+    free(ranges);
+}
+
+static void test_laser_scanner_presets(void **state)
+{
+    rc_context *ctx = (rc_context *)*state;
+    rc_sensor *s = NULL;
+    rc_sensor_info info = rc_sensor_info_default();
+
+    assert_int_equal(rc_preset_model(RC_PRESET_HOKUYO_UST10LX), RC_SENSOR_SPHERICAL);
+    assert_int_equal(rc_sensor_create_preset(ctx, RC_PRESET_HOKUYO_UST10LX, &s), RC_OK);
+    assert_int_equal(rc_sensor_get_info(s, &info), RC_OK);
+    assert_int_equal(info.rows, 1);
+    assert_int_equal(info.columns, 1081);
+    assert_near(info.range_min, 0.06, 1e-7);
+    assert_near(info.range_max, 10.0, 0.0);
+    assert_dir(s->directions, cos(DEG(-135.0)), sin(DEG(-135.0)), 0.0, 1e-6);
+    assert_dir(s->directions + 540u * 3u, 1.0, 0.0, 0.0, 1e-6);          /* straight ahead */
+    assert_dir(s->directions + 900u * 3u, cos(DEG(90.0)), 1.0, 0.0, 1e-5); /* left: counterclockwise */
+    assert_dir(s->directions + 1080u * 3u, cos(DEG(135.0)), sin(DEG(135.0)), 0.0, 1e-5);
+    assert_unit_table(s->directions, 1081u);
+    check_scanner_in_room(ctx, s, -135.0, 0.25, 1081u, 10.0);
+    assert_int_equal(rc_sensor_destroy(s), RC_OK);
+
+    assert_int_equal(rc_sensor_create_preset(ctx, RC_PRESET_ROBOTIS_LDS01, &s), RC_OK);
+    assert_int_equal(rc_sensor_get_info(s, &info), RC_OK);
+    assert_int_equal(info.rows, 1);
+    assert_int_equal(info.columns, 360);
+    assert_near(info.range_min, 0.12, 1e-7);
+    assert_near(info.range_max, 3.5, 0.0);
+    assert_dir(s->directions, 1.0, 0.0, 0.0, 1e-7);
+    assert_dir(s->directions + 90u * 3u, 0.0, 1.0, 0.0, 1e-6);
+    assert_dir(s->directions + 359u * 3u, cos(DEG(359.0)), sin(DEG(359.0)), 0.0, 1e-6);
+    check_scanner_in_room(ctx, s, 0.0, 1.0, 360u, 3.5);
+    assert_int_equal(rc_sensor_destroy(s), RC_OK);
+}
+
 /* Every ray of a custom spherical sensor against the header's formula. */
 static void test_spherical_formula(void **state)
 {
@@ -745,6 +826,8 @@ static void test_presets_api(void **state)
     assert_int_equal(rc_preset_from_name("os1-64"), RC_PRESET_OUSTER_OS1_64);
     assert_int_equal(rc_preset_from_name("d435"), RC_PRESET_REALSENSE_D435);
     assert_int_equal(rc_preset_from_name("livox-mid40"), RC_PRESET_LIVOX_MID40);
+    assert_int_equal(rc_preset_from_name("ust-10lx"), RC_PRESET_HOKUYO_UST10LX);
+    assert_int_equal(rc_preset_from_name("LDS-01"), RC_PRESET_ROBOTIS_LDS01);
     assert_int_equal(rc_preset_from_name("VLP16"), RC_PRESET_VELODYNE_VLP16);
     assert_int_equal(rc_preset_from_name("vlp1"), 0);
     assert_int_equal(rc_preset_from_name("vlp16x"), 0);
@@ -977,6 +1060,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test_setup_teardown(test_vlp16_preset, setup_ctx, teardown_ctx),
         cmocka_unit_test_setup_teardown(test_other_spherical_presets, setup_ctx, teardown_ctx),
+        cmocka_unit_test_setup_teardown(test_laser_scanner_presets, setup_ctx, teardown_ctx),
         cmocka_unit_test_setup_teardown(test_spherical_formula, setup_ctx, teardown_ctx),
         cmocka_unit_test_setup_teardown(test_single_row_axis, setup_ctx, teardown_ctx),
         cmocka_unit_test_setup_teardown(test_pinhole_frames, setup_ctx, teardown_ctx),

@@ -612,8 +612,13 @@ RC_API rc_status rc_sensor_destroy(rc_sensor *sensor);
 #define RC_PRESET_REALSENSE_D435   3u /* pinhole 848 x 480, 87 x 58 deg field of view, 0.1..10 m, body frame */
 #define RC_PRESET_LIVOX_MID40      4u /* O1Dn rosette, 38.4 deg circular field of view, 10,000 rays, 0.1..260 m */
 #define RC_PRESET_VELODYNE_VLP16_360 5u /* as VLP16 with 360 columns (1 deg) */
+/* 2-D scanners (spherical, one row at phi 0): column j is a ROS LaserScan's
+ * ranges[j], theta = angle_min + j * angle_increment, counterclockwise about z. */
+#define RC_PRESET_HOKUYO_UST10LX   6u /* 1 x 1081: theta -135..+135 deg step 0.25, 0.06..10 m */
+#define RC_PRESET_ROBOTIS_LDS01    7u /* 1 x 360: theta 0..359 deg step 1 (TurtleBot3), 0.12..3.5 m */
 
-/* Looks a preset up by name: "vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40".
+/* Looks a preset up by name: "vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40",
+ * "ust-10lx", "lds-01".
  * Returns 0 when unknown. Thread-safe. */
 RC_API uint32_t rc_preset_from_name(const char *name);
 /* The preset's model (RC_SENSOR_*), 0 when unknown. Thread-safe. */

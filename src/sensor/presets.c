@@ -24,6 +24,8 @@ static const preset_entry k_presets[] = {
     {RC_PRESET_OUSTER_OS1_64, RC_SENSOR_SPHERICAL, "os1-64"},
     {RC_PRESET_REALSENSE_D435, RC_SENSOR_PINHOLE, "d435"},
     {RC_PRESET_LIVOX_MID40, RC_SENSOR_O1DN, "livox-mid40"},
+    {RC_PRESET_HOKUYO_UST10LX, RC_SENSOR_SPHERICAL, "ust-10lx"},
+    {RC_PRESET_ROBOTIS_LDS01, RC_SENSOR_SPHERICAL, "lds-01"},
 };
 #define PRESET_COUNT (sizeof k_presets / sizeof k_presets[0])
 
@@ -97,6 +99,22 @@ rc_status rc_preset_spherical(uint32_t preset, rc_spherical_desc *desc)
         set_axis(&d.theta, DEG(-180.0), DEG(360.0 / 1024.0), 1024);
         d.common.range_min = 0.3f;
         d.common.range_max = 120.0f;
+        break;
+    case RC_PRESET_HOKUYO_UST10LX:
+        /* 270 deg in 0.25 deg steps, as urg_node publishes it (angle_min
+         * -135 deg, 1081 ranges); the datasheet's guaranteed 0.06..10 m */
+        set_axis(&d.phi, 0.0, 0.0, 1);
+        set_axis(&d.theta, DEG(-135.0), DEG(0.25), 1081);
+        d.common.range_min = 0.06f;
+        d.common.range_max = 10.0f;
+        break;
+    case RC_PRESET_ROBOTIS_LDS01:
+        /* TurtleBot3's 360 deg scanner: 360 ranges from angle 0 in 1 deg
+         * steps, 0.12..3.5 m, as its ROS driver publishes them */
+        set_axis(&d.phi, 0.0, 0.0, 1);
+        set_axis(&d.theta, 0.0, DEG(1.0), 360);
+        d.common.range_min = 0.12f;
+        d.common.range_max = 3.5f;
         break;
     default:
         return RC_ERR_INVALID_ARGUMENT;

@@ -221,7 +221,8 @@ const char *rcp_build_quality_name(uint32_t quality)
 
 uint32_t rcp_build_quality = RC_BUILD_BALANCED;
 
-static const char *const sensor_names[] = {"vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40"};
+static const char *const sensor_names[] = {"vlp16",       "vlp16-360", "os1-64", "d435",
+                                           "livox-mid40", "ust-10lx",  "lds-01"};
 
 int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset)
 {

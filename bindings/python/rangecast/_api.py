@@ -306,11 +306,12 @@ class Context(object):
 
     # -- sensors ----------------------------------------------------------
     def preset_sensor(self, name):
-        """A preset: "vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40"."""
+        """A preset: "vlp16", "vlp16-360", "os1-64", "d435", "livox-mid40", and the
+        2-D scanners "ust-10lx" (Hokuyo UST-10LX) and "lds-01" (TurtleBot3's LDS-01)."""
         preset = F.lib.rc_preset_from_name(str(name).encode())
         if preset == 0:
             raise Error(F.ERR_INVALID_ARGUMENT, "no sensor preset named %r (vlp16, vlp16-360, os1-64, d435, "
-                        "livox-mid40)" % (name,))
+                        "livox-mid40, ust-10lx, lds-01)" % (name,))
         handle = ctypes.c_void_p()
         self._call("rc_sensor_create_preset", F.lib.rc_sensor_create_preset, self._handle(), preset, ctypes.byref(handle))
         return Sensor(self, handle)
