@@ -1,7 +1,8 @@
 /* The packet traversal (SSE2 / NEON / scalar box tests) gives every ray
  * exactly the hit of the single-ray traversal: same t, triangle and
  * barycentrics, bit for bit, for coherent tiles, mixed-octant tiles, axis-
- * parallel rays and partial packets; so do packets taking turns
+ * parallel rays, planar tiles (a direction component 0 in every lane) and
+ * partial packets; so do packets taking turns
  * (rc__mesh_intersect_packets), whatever their number and mix. */
 #include <math.h>
 #include <string.h>
@@ -84,6 +85,11 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
     uint32_t i;
     for (i = 0; i < 3; ++i) org[i] = (float)((uniform() - 0.5) * 12.0);
     if (tile % 11 == 0) org[0] = box_lo[0];
+    if (tile % 19 == 0 && (tile / 19) % 2 == 0) {
+        const uint32_t k = (tile / 19) % 3;
+        org[k] = (tile / 38) % 2 ? box_hi[k] : box_lo[k];
+    }
+    if (tile % 23 == 0) org[(tile / 23) % 3] = box_hi[(tile / 23) % 3];
     for (i = 0; i < n; ++i) {
         double y = yaw + (uniform() - 0.5) * spread, p = pitch + (uniform() - 0.5) * spread;
         dir[0] = (float)(cos(p) * cos(y));
@@ -91,6 +97,13 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
         dir[2] = (float)sin(p);
         if (tile % 13 == 0) dir[i % 3] = 0.0f;
         if (tile % 17 == 0) dir[(i + 1) % 3] = -0.0f;
+        /* planar tiles (an upright 2-D scanner): one component 0 in every
+         * lane, the same sign; every other one of them from a box plane
+         * of that axis, where plane - origin is 0 and 0 * inf is NaN */
+        if (tile % 19 == 0) dir[(tile / 19) % 3] = (tile / 57) % 2 ? -0.0f : 0.0f;
+        /* and with a few lanes near but not at 0 (finite and infinite
+         * reciprocals in one packet) */
+        if (tile % 23 == 0) dir[(tile / 23) % 3] = i % 3 ? -0.0f : -1e-6f * (float)(i + 1);
         rc__ray_prepare(&rays[i], org, dir);
         hit_init(&hits[i]);
         found[i] = 0;

@@ -169,8 +169,12 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
         const float32x4_t o = vdupq_n_f32(L->org[k]), lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
         const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), o);
         const float32x4_t pf = vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), o);
-        t0 = vmaxq_f32(vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi)), t0);
-        t1 = vminq_f32(vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi)), t1);
+        const float32x4_t a = vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi));
+        const float32x4_t b = vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi));
+        /* selects, as in box_mask: a NaN (0 * inf) imposes nothing, where
+         * NEON's max and min would propagate it */
+        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+        t1 = vbslq_f32(vcltq_f32(b, t1), b, t1);
     }
     vst1q_f32(tn, t0);
     h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
@@ -395,8 +399,10 @@ static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, ui
 #endif
     /* an infinite reciprocal (a zero direction component) gives box_mask's
      * NaN cases, and a tmax beyond float range inf * 0: the interval test
-     * cannot bound those */
-    for (k = 0; k < 3; ++k) finite &= P->ilo[k] > -FLT_MAX && P->ihi[k] < FLT_MAX;
+     * cannot bound those, except on an axis where every lane has the same
+     * reciprocal (an upright 2-D scanner's z, all +inf): there its products
+     * are each lane's own, NaN included, and NaN imposes nothing in both */
+    for (k = 0; k < 3; ++k) finite &= (P->ilo[k] > -FLT_MAX && P->ihi[k] < FLT_MAX) || P->ilo[k] == P->ihi[k];
     P->usable = finite && P->tmax < FLT_MAX;
     return 1;
 }
