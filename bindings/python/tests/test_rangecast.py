@@ -142,6 +142,22 @@ class TestAnalytic(Base):
         self.assertLess(on_wall.max(), 1e-4)
         np.testing.assert_allclose(np.linalg.norm(scan["points"], axis=-1), scan["ranges"], rtol=1e-5)
 
+    def test_2d_scanner_presets_in_a_room(self):
+        # an upright 2-D scanner at the room's centre: column j looks along
+        # angle_min + j * increment (a ROS LaserScan), each ray meets a wall
+        scene = self.ctx.mesh_scene(*box((-2, -3, -1), (2, 3, 1)), copy=True)
+        for name, angle_min, step, count in (("ust-10lx", -135.0, 0.25, 1081), ("lds-01", 0.0, 1.0, 360)):
+            scan = self.ctx.simulate(scene, self.ctx.preset_sensor(name), IDENTITY, ("ranges",))["ranges"]
+            self.assertEqual(scan.shape, (1, 1, count))
+            theta = np.radians(angle_min + step * np.arange(count))
+            with np.errstate(divide="ignore"):
+                want = np.minimum(2.0 / np.abs(np.cos(theta)), 3.0 / np.abs(np.sin(theta)))
+            reach = {"ust-10lx": 10.0, "lds-01": 3.5}[name]
+            near = np.abs(want - reach) > 1e-3
+            inside = near & (want < reach)
+            np.testing.assert_allclose(scan[0, 0][inside], want[inside], rtol=1e-5)
+            self.assertTrue(np.isposinf(scan[0, 0][near & (want > reach)]).all())
+
     def test_sensor_inside_sphere(self):
         scene = self.ctx.mesh_scene(*uv_sphere(10.0))
         lidar = self.ctx.preset_sensor("vlp16-360")
