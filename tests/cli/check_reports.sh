@@ -19,7 +19,7 @@ BACKEND=${*:---backend auto}
 # (Embree when built in, else the built-in BVH).
 backend=$(echo "$BACKEND" | sed -n 's/^--backend[ =]\([a-z]*\)$/\1/p')
 if [ -z "$backend" ] || [ "$backend" = auto ]; then
-    if "$RC" help | grep -q "^Backends in this library:.*embree"; then backend=embree; else backend=bvh; fi
+    if "$RC" help | grep -q "^Backends in this library:[^(]*embree"; then backend=embree; else backend=bvh; fi
 fi
 case $backend in bvh | embree | vulkan) ;; *) fail "unexpected backend '$backend'" ;; esac
 
