@@ -80,7 +80,7 @@ static void *worker_main(void *arg)
 {
     rc__pool *pool = ((worker_arg *)arg)->pool;
     uint32_t index = ((worker_arg *)arg)->index;
-    uint64_t seen = 0;
+    uint64_t seen;
     pthread_mutex_lock(&pool->lock);
     seen = pool->generation;
     ++pool->ready;
