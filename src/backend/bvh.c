@@ -76,20 +76,15 @@ static void choose_tiling(const rc_sensor *s, tiling *tl)
     tl->grid_cols = (s->columns + tl->tile_cols - 1) / tl->tile_cols;
 }
 
-static void world_ray(const rc__xformf *world, const float *ds, const float *os, rc__ray *ray)
+/* An OnDn ray in the map frame (one-origin rays: rc__rays_prepare_turned). */
+static void world_ray_ondn(const rc__xformf *world, const float *ds, const float *os, rc__ray *ray)
 {
     float org[3], dir[3];
     rc__rot_apply_f(world->r, ds, dir);
-    if (os) {
-        rc__rot_apply_f(world->r, os, org);
-        org[0] += world->t[0];
-        org[1] += world->t[1];
-        org[2] += world->t[2];
-    } else {
-        org[0] = world->t[0];
-        org[1] = world->t[1];
-        org[2] = world->t[2];
-    }
+    rc__rot_apply_f(world->r, os, org);
+    org[0] += world->t[0];
+    org[1] += world->t[1];
+    org[2] += world->t[2];
     rc__ray_prepare(ray, org, dir);
 }
 
@@ -180,9 +175,11 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
             for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
                 for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b)
                     idx[k][n[k]++] = rc__sensor_traced_ray(sensor, (r0 + a) * sensor->columns + c0 + b);
+            if (!sensor->origins) rc__rays_prepare_turned(world.r, world.t, sensor->directions, idx[k], n[k], rays[k]);
             for (i = 0; i < n[k]; ++i) {
-                const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
-                world_ray(&world, sensor->directions + (size_t)idx[k][i] * 3u, os, &rays[k][i]);
+                if (sensor->origins)
+                    world_ray_ondn(&world, sensor->directions + (size_t)idx[k][i] * 3u,
+                                   sensor->origins + (size_t)idx[k][i] * 3u, &rays[k][i]);
                 hit_reset(&hits[k][i], sensor->range_max);
                 found[k][i] = 0;
             }

@@ -51,6 +51,11 @@ typedef struct rc__hit {
 } rc__hit;
 
 void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3]);
+/* rays[i] = rc__ray_prepare(org, R dirs[idx[i]]) for i < n, R the row-major
+ * turn r (rc__rot_apply_f), the same values bit for bit; SIMD where there is
+ * SSE2 (ray_batch.c). */
+void rc__rays_prepare_turned(const float r[9], const float org[3], const float *dirs, const uint32_t *idx,
+                             uint32_t n, rc__ray *rays);
 
 /* Item bounds of every triangle (for the builder). */
 void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);

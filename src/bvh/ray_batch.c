@@ -1,0 +1,175 @@
+/* rc__rays_prepare_turned: rc__ray_prepare for many rays from one origin,
+ * four at a time in SSE2 or AArch64 NEON (32-bit ARM has no vector division:
+ * it takes the per-ray path). Every value is the one the per-ray path computes:
+ * the same IEEE operations in the same order (the turn as rc__rot_apply_f,
+ * reciprocals and shear constants as divisions), with selects where the
+ * per-ray path branches; 1 / +-0 is +-inf in SIMD division as copysignf
+ * gives it there. What it saves is the per-ray divisions and the
+ * unpredictable branches on the dominant axis. */
+#include "bvh/mesh.h"
+
+#include "core/rmath.h"
+
+#if defined(__SSE2__) && !defined(RC__PACKET_FORCE_SCALAR)
+#include <emmintrin.h>
+#define RC__RAY_BATCH_SSE2 1
+#elif defined(__ARM_NEON) && defined(__aarch64__) && !defined(RC__PACKET_FORCE_SCALAR)
+#include <arm_neon.h>
+#define RC__RAY_BATCH_NEON 1
+#endif
+
+static void prepare_one(const float r[9], const float org[3], const float *d_sensor, rc__ray *ray)
+{
+    float dir[3];
+    rc__rot_apply_f(r, d_sensor, dir);
+    rc__ray_prepare(ray, org, dir);
+}
+
+#if defined(RC__RAY_BATCH_SSE2) || defined(RC__RAY_BATCH_NEON)
+/* Four prepared rays in lanes: v[0..2] direction, v[3..5] reciprocal,
+ * v[6..7] shear sx, sy, v[8] sz; bit i of y_bits / z_bits: ray i's kz is
+ * 1 / 2 (else 0); of neg_bits: its component along kz is negative. */
+typedef struct four_rays {
+    float v[9][4];
+    int y_bits, z_bits, neg_bits;
+} four_rays;
+
+static void scatter_four(const four_rays *f, const float org[3], rc__ray *rays)
+{
+    int i;
+    for (i = 0; i < 4; ++i) {
+        rc__ray *ray = &rays[i];
+        const int kz = ((f->y_bits >> i) & 1) ? 1 : ((f->z_bits >> i) & 1) ? 2 : 0;
+        const int kx = kz == 2 ? 0 : kz + 1, ky = kx == 2 ? 0 : kx + 1;
+        const int swap = (f->neg_bits >> i) & 1;
+        ray->org[0] = org[0];
+        ray->org[1] = org[1];
+        ray->org[2] = org[2];
+        ray->dir[0] = f->v[0][i];
+        ray->dir[1] = f->v[1][i];
+        ray->dir[2] = f->v[2][i];
+        ray->inv_dir[0] = f->v[3][i];
+        ray->inv_dir[1] = f->v[4][i];
+        ray->inv_dir[2] = f->v[5][i];
+        ray->kz = kz;
+        ray->kx = swap ? ky : kx;
+        ray->ky = swap ? kx : ky;
+        ray->sx = f->v[6][i];
+        ray->sy = f->v[7][i];
+        ray->sz = f->v[8][i];
+    }
+}
+#endif
+
+#if defined(RC__RAY_BATCH_SSE2)
+static inline __m128 select_ps(__m128 mask, __m128 a, __m128 b)
+{
+    return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
+/* Four rays: lanes of the direction table's rows i0..i3. */
+static void prepare_four(const float r[9], const float org[3], const float *const d[4], rc__ray *rays)
+{
+    const __m128 one = _mm_set1_ps(1.0f);
+    const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
+    const __m128 sx_ = _mm_setr_ps(d[0][0], d[1][0], d[2][0], d[3][0]);
+    const __m128 sy_ = _mm_setr_ps(d[0][1], d[1][1], d[2][1], d[3][1]);
+    const __m128 sz_ = _mm_setr_ps(d[0][2], d[1][2], d[2][2], d[3][2]);
+    /* the turn, as rc__rot_apply_f: (r0 x + r1 y) + r2 z */
+    const __m128 wx = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(r[0]), sx_), _mm_mul_ps(_mm_set1_ps(r[1]), sy_)),
+                                 _mm_mul_ps(_mm_set1_ps(r[2]), sz_));
+    const __m128 wy = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(r[3]), sx_), _mm_mul_ps(_mm_set1_ps(r[4]), sy_)),
+                                 _mm_mul_ps(_mm_set1_ps(r[5]), sz_));
+    const __m128 wz = _mm_add_ps(_mm_add_ps(_mm_mul_ps(_mm_set1_ps(r[6]), sx_), _mm_mul_ps(_mm_set1_ps(r[7]), sy_)),
+                                 _mm_mul_ps(_mm_set1_ps(r[8]), sz_));
+    const __m128 ix = _mm_div_ps(one, wx), iy = _mm_div_ps(one, wy), iz = _mm_div_ps(one, wz);
+    const __m128 ax = _mm_and_ps(wx, abs_mask), ay = _mm_and_ps(wy, abs_mask), az = _mm_and_ps(wz, abs_mask);
+    /* kz: the largest magnitude, the first on a tie (y beats x only when
+     * larger, z beats the winner only when larger) */
+    const __m128 y_wins = _mm_cmpgt_ps(ay, ax);
+    const __m128 m = select_ps(y_wins, ay, ax);
+    const __m128 z_wins = _mm_cmpgt_ps(az, m);
+    const __m128 y_only = _mm_andnot_ps(z_wins, y_wins);
+    /* along kz: its component, its reciprocal; kx = kz + 1 and ky = kz + 2
+     * (mod 3), swapped when the component along kz is negative */
+    const __m128 dz = select_ps(z_wins, wz, select_ps(y_only, wy, wx));
+    const __m128 rz = select_ps(z_wins, iz, select_ps(y_only, iy, ix));
+    const __m128 next = select_ps(z_wins, wx, select_ps(y_only, wz, wy));  /* component kz + 1 */
+    const __m128 after = select_ps(z_wins, wy, select_ps(y_only, wx, wz)); /* component kz + 2 */
+    const __m128 neg = _mm_cmplt_ps(dz, _mm_setzero_ps());
+    const __m128 sx = _mm_div_ps(select_ps(neg, after, next), dz);
+    const __m128 sy = _mm_div_ps(select_ps(neg, next, after), dz);
+    four_rays f;
+    _mm_storeu_ps(f.v[0], wx);
+    _mm_storeu_ps(f.v[1], wy);
+    _mm_storeu_ps(f.v[2], wz);
+    _mm_storeu_ps(f.v[3], ix);
+    _mm_storeu_ps(f.v[4], iy);
+    _mm_storeu_ps(f.v[5], iz);
+    _mm_storeu_ps(f.v[6], sx);
+    _mm_storeu_ps(f.v[7], sy);
+    _mm_storeu_ps(f.v[8], rz);
+    f.y_bits = _mm_movemask_ps(y_only);
+    f.z_bits = _mm_movemask_ps(z_wins);
+    f.neg_bits = _mm_movemask_ps(neg);
+    scatter_four(&f, org, rays);
+}
+#endif
+
+#if defined(RC__RAY_BATCH_NEON)
+/* prepare_four in NEON: the same operations (vdivq_f32 is IEEE division) */
+static void prepare_four(const float r[9], const float org[3], const float *const d[4], rc__ray *rays)
+{
+    static const uint32_t bit_of_lane[4] = {1u, 2u, 4u, 8u};
+    const uint32x4_t lane_bits = vld1q_u32(bit_of_lane);
+    const float32x4_t one = vdupq_n_f32(1.0f);
+    const float vx[4] = {d[0][0], d[1][0], d[2][0], d[3][0]};
+    const float vy[4] = {d[0][1], d[1][1], d[2][1], d[3][1]};
+    const float vz[4] = {d[0][2], d[1][2], d[2][2], d[3][2]};
+    const float32x4_t sx_ = vld1q_f32(vx), sy_ = vld1q_f32(vy), sz_ = vld1q_f32(vz);
+    const float32x4_t wx = vaddq_f32(vaddq_f32(vmulq_n_f32(sx_, r[0]), vmulq_n_f32(sy_, r[1])), vmulq_n_f32(sz_, r[2]));
+    const float32x4_t wy = vaddq_f32(vaddq_f32(vmulq_n_f32(sx_, r[3]), vmulq_n_f32(sy_, r[4])), vmulq_n_f32(sz_, r[5]));
+    const float32x4_t wz = vaddq_f32(vaddq_f32(vmulq_n_f32(sx_, r[6]), vmulq_n_f32(sy_, r[7])), vmulq_n_f32(sz_, r[8]));
+    const float32x4_t ix = vdivq_f32(one, wx), iy = vdivq_f32(one, wy), iz = vdivq_f32(one, wz);
+    const float32x4_t ax = vabsq_f32(wx), ay = vabsq_f32(wy), az = vabsq_f32(wz);
+    const uint32x4_t y_wins = vcgtq_f32(ay, ax);
+    const uint32x4_t z_wins = vcgtq_f32(az, vbslq_f32(y_wins, ay, ax));
+    const uint32x4_t y_only = vbicq_u32(y_wins, z_wins);
+    const float32x4_t dz = vbslq_f32(z_wins, wz, vbslq_f32(y_only, wy, wx));
+    const float32x4_t rz = vbslq_f32(z_wins, iz, vbslq_f32(y_only, iy, ix));
+    const float32x4_t next = vbslq_f32(z_wins, wx, vbslq_f32(y_only, wz, wy));
+    const float32x4_t after = vbslq_f32(z_wins, wy, vbslq_f32(y_only, wx, wz));
+    const uint32x4_t neg = vcltq_f32(dz, vdupq_n_f32(0.0f));
+    four_rays f;
+    vst1q_f32(f.v[0], wx);
+    vst1q_f32(f.v[1], wy);
+    vst1q_f32(f.v[2], wz);
+    vst1q_f32(f.v[3], ix);
+    vst1q_f32(f.v[4], iy);
+    vst1q_f32(f.v[5], iz);
+    vst1q_f32(f.v[6], vdivq_f32(vbslq_f32(neg, after, next), dz));
+    vst1q_f32(f.v[7], vdivq_f32(vbslq_f32(neg, next, after), dz));
+    vst1q_f32(f.v[8], rz);
+    f.y_bits = (int)vaddvq_u32(vandq_u32(y_only, lane_bits));
+    f.z_bits = (int)vaddvq_u32(vandq_u32(z_wins, lane_bits));
+    f.neg_bits = (int)vaddvq_u32(vandq_u32(neg, lane_bits));
+    scatter_four(&f, org, rays);
+}
+#endif
+
+void rc__rays_prepare_turned(const float r[9], const float org[3], const float *dirs, const uint32_t *idx,
+                             uint32_t n, rc__ray *rays)
+{
+    uint32_t i = 0;
+#if defined(RC__RAY_BATCH_SSE2) || defined(RC__RAY_BATCH_NEON)
+    for (; i + 4u <= n; i += 4u) {
+        const float *d[4];
+        d[0] = dirs + (size_t)idx[i] * 3u;
+        d[1] = dirs + (size_t)idx[i + 1u] * 3u;
+        d[2] = dirs + (size_t)idx[i + 2u] * 3u;
+        d[3] = dirs + (size_t)idx[i + 3u] * 3u;
+        prepare_four(r, org, d, rays + i);
+    }
+#endif
+    for (; i < n; ++i) prepare_one(r, org, dirs + (size_t)idx[i] * 3u, &rays[i]);
+}
