@@ -67,7 +67,7 @@ static inline __m128 select_ps(__m128 mask, __m128 a, __m128 b)
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
 }
 
-/* Four rays: lanes of the direction table's rows i0..i3. */
+/* Four rays, sensor-frame directions d[0..3], into rays[0..3]. */
 static void prepare_four(const float r[9], const float org[3], const float *const d[4], rc__ray *rays)
 {
     const __m128 one = _mm_set1_ps(1.0f);
