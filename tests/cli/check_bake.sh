@@ -35,6 +35,9 @@ run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2
 grep -Eq '"poses_per_call":1[,}]' out.txt || { cat out.txt; fail "bench reports poses_per_call 1"; }
 cmp ply.f32 one.f32 || fail "one pose a call changed the ranges"
 run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" bench --poses-per-call 0
+# a short-range sensor on the standard sphere: every ray misses, and bench says why
+run 0 "no ray returned: lds-01 reaches 3.5 m" "$RC" bench --triangles 1k --pose-count 2 --repeat 1 --sensor lds-01 $BACKEND
+grep -Eq '"hit_fraction":0[,}]' out.txt || { cat out.txt; fail "lds-01 on the standard sphere returns nothing"; }
 run 0 "" "$RC" bake --map sphere.ply --out again.rcmap --threads 1
 cmp sphere.rcmap again.rcmap || fail "two bakes of one map differ"
 # bench --help lists every key the JSON line has

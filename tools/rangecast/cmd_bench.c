@@ -653,6 +653,13 @@ int rcp_cmd_bench(int argc, char **argv)
     if (acc.differing)
         fprintf(stderr, "rangecast bench: warning: %llu scans give different ranges with "
                         "RANGES|HITS|PRIM_IDS|GEOM_IDS than with RANGES alone\n", (unsigned long long)acc.differing);
+    if (is_sphere && acc.rays > 0 && acc.hits == 0)
+        fprintf(stderr,
+                "rangecast bench: note: no ray returned: %s reaches %g m, and the standard sphere lies 10 to 30 m "
+                "from its poses. For a short-range sensor bench a map of its scale, e.g.\n"
+                "  rangecast gen --sphere 100k --radius 3 -o small.ply && rangecast gen --poses 1000 --radius 1 -o "
+                "near.bin\n  rangecast bench --map small.ply --poses near.bin --sensor %s\n",
+                a.sensor_name, ref.range_max, a.sensor_name);
 
     /* ---- the JSON line ---- */
     {
