@@ -100,6 +100,15 @@ typedef struct rc__emb_scene {
     uint32_t mesh_inst_id;      /* max_geoms + max_insts */
     uint32_t dynamic;           /* 1 once a mesh was updated: the meshes' scene builds in two levels */
     uint32_t unfinished;        /* 1 while a commit has not completed (it failed, or runs) */
+    uint32_t twins_any;         /* 1 when some instance has a lower twin (inst_twin) */
+    /* The tie rule across instances: inst_twin[i] is the lowest instance with
+     * the same source and the same transform bit for bit (i itself when none),
+     * found at commit through twin_slots (twin_mask + 1 of them). Such twins
+     * give the same hit at the same distance; the tracer reports the lowest,
+     * as the built-in backend does. */
+    uint32_t *inst_twin;        /* max_insts */
+    uint32_t *twin_slots;
+    uint32_t twin_mask;
     uint32_t reserved0;
 } rc__emb_scene;
 

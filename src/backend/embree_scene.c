@@ -23,9 +23,12 @@
  * copies of a wall, say). Commit finds, per mesh, triangles whose three vertex
  * positions equal an earlier triangle's in the same order (the only duplicates
  * that are guaranteed the same distance bit for bit), and the tracer reports
- * the lowest of them. Rays through a shared edge, partly overlapping coplanar
- * triangles, and duplicates across meshes or in another vertex order may
- * still report a different (equally near) triangle than the built-in backend. */
+ * the lowest of them. Across instances, twins (the same source at the same
+ * transform, bit for bit: find_twin_instances) give the same hit, and the
+ * lowest reports it. Rays through a shared edge, partly overlapping coplanar
+ * triangles, and duplicates across meshes, in another vertex order or under
+ * different transforms may still report a different (equally near) triangle
+ * than the built-in backend. */
 #include "backend/embree_impl.h"
 
 #include <stdbool.h>
@@ -34,11 +37,23 @@
 
 static size_t align16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
+/* Hash slots for finding twin instances: a power of two, at least twice the
+ * instances (0 without instances). */
+static size_t twin_slot_count(uint32_t max_insts)
+{
+    size_t n = 16;
+    if (max_insts == 0) return 0;
+    while (n < (size_t)max_insts * 2u) n <<= 1;
+    return n;
+}
+
 static size_t block_size(const rc_scene_desc *desc)
 {
     size_t geoms = desc->max_geometries ? desc->max_geometries : 1u;
     return align16(sizeof(rc__emb_scene)) + align16(geoms * sizeof(rc__emb_geom)) +
-           (size_t)desc->max_instances * sizeof(RTCGeometry);
+           align16((size_t)desc->max_instances * sizeof(RTCGeometry)) +
+           align16((size_t)desc->max_instances * sizeof(uint32_t)) +
+           twin_slot_count(desc->max_instances) * sizeof(uint32_t);
 }
 
 size_t rc__emb_scene_bytes(const rc_scene_desc *desc) { return rc__arena_cost(block_size(desc)); }
@@ -352,6 +367,41 @@ static rc_status instance_set(rc__emb_device *d, rc__emb_scene *es, const rc_sce
     return rc__emb_check(d, "rc_scene_commit (instance)");
 }
 
+/* es->inst_twin for the scene's instances (see embree_impl.h): an
+ * open-addressing table of first occurrences, filled in instance order, so
+ * each instance meets its lowest twin first. */
+static void find_twin_instances(rc__emb_scene *es, const rc_scene *scene)
+{
+    uint32_t i;
+    es->twins_any = 0;
+    if (scene->inst_count < 2) {
+        for (i = 0; i < scene->inst_count; ++i) es->inst_twin[i] = i;
+        return;
+    }
+    memset(es->twin_slots, 0xFF, ((size_t)es->twin_mask + 1u) * sizeof(uint32_t));
+    for (i = 0; i < scene->inst_count; ++i) {
+        const rc__instance *in = &scene->insts[i];
+        const unsigned char *bytes = (const unsigned char *)&in->to_world;
+        uint64_t h = 1469598103934665603ull ^ (uint64_t)(uintptr_t)in->source;
+        size_t k, s;
+        for (k = 0; k < sizeof in->to_world; ++k) h = (h ^ bytes[k]) * 1099511628211ull;
+        for (s = (size_t)(h ^ (h >> 32)) & es->twin_mask;; s = (s + 1u) & es->twin_mask) {
+            const uint32_t j = es->twin_slots[s];
+            if (j == 0xFFFFFFFFu) {
+                es->twin_slots[s] = i;
+                es->inst_twin[i] = i;
+                break;
+            }
+            if (scene->insts[j].source == in->source &&
+                memcmp(&scene->insts[j].to_world, &in->to_world, sizeof in->to_world) == 0) {
+                es->inst_twin[i] = j;
+                es->twins_any = 1;
+                break;
+            }
+        }
+    }
+}
+
 static rc_status scene_state(rc__emb_device *d, rc_scene *scene, rc__emb_scene **out)
 {
     rc_context *ctx = scene->ctx;
@@ -370,9 +420,14 @@ static rc_status scene_state(rc__emb_device *d, rc_scene *scene, rc__emb_scene *
     es->max_geoms = scene->desc.max_geometries ? scene->desc.max_geometries : 1u;
     es->max_insts = scene->desc.max_instances;
     es->geoms = (rc__emb_geom *)(void *)(block + align16(sizeof *es));
-    es->insts = es->max_insts ? (RTCGeometry *)(void *)(block + align16(sizeof *es) +
-                                                         align16(es->max_geoms * sizeof(rc__emb_geom)))
-                              : NULL;
+    if (es->max_insts) {
+        unsigned char *p = block + align16(sizeof *es) + align16(es->max_geoms * sizeof(rc__emb_geom));
+        es->insts = (RTCGeometry *)(void *)p;
+        p += align16(es->max_insts * sizeof(RTCGeometry));
+        es->inst_twin = (uint32_t *)(void *)p;
+        es->twin_slots = (uint32_t *)(void *)(p + align16(es->max_insts * sizeof(uint32_t)));
+        es->twin_mask = (uint32_t)(twin_slot_count(es->max_insts) - 1u);
+    }
     es->mesh_inst_id = es->max_geoms + es->max_insts;
     es->scene = rtcNewScene(d->device);
     /* a scene that can hold instances keeps its meshes apart (see embree_impl.h) */
@@ -497,6 +552,10 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
         RC_TRY(mesh_instance_set(d, es, meshes_changed));
     }
     for (i = 0; i < scene->inst_count; ++i) RC_TRY(instance_set(d, es, scene, i));
+    if (d->options.tie_rule && scene->inst_count > 0)
+        find_twin_instances(es, scene);
+    else
+        es->twins_any = 0;
     commit_scene(es->scene, es->mesh_scene ? NULL : progress, user);
     RC_TRY(rc__emb_check(d, "rc_scene_commit"));
     rtcGetSceneBounds(es->scene, &b);

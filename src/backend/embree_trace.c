@@ -125,6 +125,9 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t r, flo
     /* the own meshes: directly, or through a split scene's identity instance */
     hit->inst = inst == RTC_INVALID_GEOMETRY_ID || inst == run->es->mesh_inst_id ? RC_INVALID_ID
                                                                                 : inst - run->es->max_geoms;
+    /* a twin instance (same source, same transform) gives the same hit: the
+     * lowest one reports it, as in the built-in backend */
+    if (hit->inst != RC_INVALID_ID && run->es->twins_any) hit->inst = run->es->inst_twin[hit->inst];
     if (run->dups) {
         const rc__emb_scene *src = run->es;
         if (hit->inst != RC_INVALID_ID)
