@@ -30,6 +30,7 @@
  * different transforms may still report a different (equally near) triangle
  * than the built-in backend. */
 #include "backend/embree_impl.h"
+#include "core/crc32c.h"
 
 #include <stdbool.h>
 #include <stdlib.h>
@@ -381,11 +382,10 @@ static void find_twin_instances(rc__emb_scene *es, const rc_scene *scene)
     memset(es->twin_slots, 0xFF, ((size_t)es->twin_mask + 1u) * sizeof(uint32_t));
     for (i = 0; i < scene->inst_count; ++i) {
         const rc__instance *in = &scene->insts[i];
-        const unsigned char *bytes = (const unsigned char *)&in->to_world;
-        uint64_t h = 1469598103934665603ull ^ (uint64_t)(uintptr_t)in->source;
-        size_t k, s;
-        for (k = 0; k < sizeof in->to_world; ++k) h = (h ^ bytes[k]) * 1099511628211ull;
-        for (s = (size_t)(h ^ (h >> 32)) & es->twin_mask;; s = (s + 1u) & es->twin_mask) {
+        const uint32_t h = rc__crc32c(rc__crc32c(0, &in->source, sizeof in->source), &in->to_world,
+                                      sizeof in->to_world);
+        size_t s;
+        for (s = (size_t)h & es->twin_mask;; s = (s + 1u) & es->twin_mask) {
             const uint32_t j = es->twin_slots[s];
             if (j == 0xFFFFFFFFu) {
                 es->twin_slots[s] = i;
