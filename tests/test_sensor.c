@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "rangecast/rangecast.h"
+#include "rc_test.h"
 #include "sensor/sensor.h"
 
 #define PI 3.14159265358979323846
@@ -229,26 +230,16 @@ static void test_other_spherical_presets(void **state)
 static void check_scanner_in_room(rc_context *ctx, rc_sensor *s, double theta0_deg, double step_deg, uint32_t n,
                                   double rmax)
 {
-    static const float v[8 * 3] = {-2, -3, -1, 2, -3, -1, 2, 3, -1, -2, 3, -1,
-                                   -2, -3, 1,  2, -3, 1,  2, 3, 1,  -2, 3, 1};
-    static const uint32_t idx[12 * 3] = {0, 2, 1, 0, 3, 2, 4, 5, 6, 4, 6, 7, 0, 1, 5, 0, 5, 4,
-                                         1, 2, 6, 1, 6, 5, 2, 3, 7, 2, 7, 6, 3, 0, 4, 3, 4, 7};
-    rc_scene_desc sd = rc_scene_desc_default();
-    rc_mesh_desc md = rc_mesh_desc_default();
+    static const float lo[3] = {-2, -3, -1}, hi[3] = {2, 3, 1};
+    rcu_mesh box;
     rc_results res = rc_results_default();
     rc_pose pose = rc_pose_identity();
-    rc_scene *room = NULL;
+    rc_scene *room;
     float *ranges = (float *)malloc(sizeof(float) * n);
-    uint32_t geom, j, far = 0;
+    uint32_t j, far = 0;
     assert_non_null(ranges);
-    sd.max_triangles = 12;
-    md.vertices = v;
-    md.vertex_count = 8;
-    md.indices = idx;
-    md.triangle_count = 12;
-    assert_int_equal(rc_scene_create(ctx, &sd, &room), RC_OK);
-    assert_int_equal(rc_scene_add_mesh(room, &md, &geom), RC_OK);
-    assert_int_equal(rc_scene_commit(room), RC_OK);
+    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    room = rct_scene_mesh(ctx, &box, RC_MESH_COPY);
     res.attributes = RC_ATTR_RANGES;
     res.ranges = ranges;
     res.capacity = n;
@@ -266,6 +257,7 @@ static void check_scanner_in_room(rc_context *ctx, rc_sensor *s, double theta0_d
     }
     if (rmax < 3.6) assert_true(far > 0); /* the corners are out of reach */
     assert_int_equal(rc_scene_destroy(room), RC_OK);
+    rcu_mesh_free(&box);
     free(ranges);
 }
 
