@@ -536,6 +536,38 @@ static void test_bad_blobs(void **state)
     free(b);
 
     b = edited(&m);
+    {
+        /* the root's second inner child replaced by its first, under a box
+         * holding both: every slot check passes, yet node 1 is reached twice
+         * (a chain of such links multiplies traversal work per link) */
+        uint32_t c, first = 4, second = 4, k;
+        memcpy(&node, b + nodes, sizeof node);
+        for (c = 0; c < 4; ++c)
+            if (node.child[c] != RC__WIDE_EMPTY && node.count[c] == 0) {
+                if (first == 4) {
+                    first = c;
+                } else if (second == 4) {
+                    second = c;
+                }
+            }
+        assert_true(second < 4); /* the fixture's root has two inner children */
+        assert_int_equal(node.child[first], 1);
+        for (k = 0; k < 3; ++k) {
+            const float lo = node.box[2 * k][first] < node.box[2 * k][second] ? node.box[2 * k][first]
+                                                                              : node.box[2 * k][second];
+            const float hi = node.box[2 * k + 1][first] > node.box[2 * k + 1][second] ? node.box[2 * k + 1][first]
+                                                                                      : node.box[2 * k + 1][second];
+            node.box[2 * k][first] = node.box[2 * k][second] = lo;
+            node.box[2 * k + 1][first] = node.box[2 * k + 1][second] = hi;
+        }
+        node.child[second] = 1;
+        memcpy(b + nodes, &node, sizeof node);
+    }
+    reseal(b, m.bytes);
+    expect_refused(ctx, b, m.bytes, 0, RC_ERR_CORRUPT_DATA, "depth-first walk", "a node with two parents");
+    free(b);
+
+    b = edited(&m);
     memcpy(&node, b + nodes, sizeof node);
     node.box[1][0] = node.box[0][0]; /* slot 0's box loses its width in x */
     memcpy(b + nodes, &node, sizeof node);

@@ -9,9 +9,12 @@
  *   - each node's children: an unused slot exactly as the collapse leaves it
  *     (an empty box), an inner child after its parent (so every descent ends),
  *     a leaf's run inside the slots; and every box holding what lies below
- *     it, so the baked tree culls nothing a fresh build would test.
- * A tree deeper than a build makes stays safe: traversal stacks drop
- * entries past their size instead of overflowing (wide_trace.c, packet.c). */
+ *     it, so the baked tree culls nothing a fresh build would test;
+ *   - the nodes one tree in depth-first order: each reached once (no node
+ *     shared by two parents, which could make traversal work exponential),
+ *     none left over, no deeper than a build makes.
+ * Traversal stacks still drop entries past their size instead of
+ * overflowing (wide_trace.c, packet.c). */
 #include "scene/baked_format.h"
 #include "scene/scene.h"
 
@@ -177,6 +180,43 @@ static rc_status check_slot(rc_context *ctx, uint32_t g, const rc__baked_geom *r
     return RC_OK;
 }
 
+/* The nodes form one tree laid out depth first, as the collapse writes it
+ * (wide.c): a walk from the root that takes inner children in slot order
+ * meets nodes 0, 1, 2 ... each exactly once. The slot checks alone would let
+ * a node be reached from several parents, and a chain of nodes whose four
+ * slots all lead to the next makes a traversal's work grow fourfold per link:
+ * a scan that never ends instead of a crash. */
+static rc_status check_tree_order(rc_context *ctx, uint32_t g, const rc__baked_geom *r, const rc__wnode *nodes)
+{
+    /* pending siblings: at most three a level over the depth a build keeps */
+    uint32_t stack[3u * RC__BVH_MAX_DEPTH + 4u];
+    uint32_t sp = 0, expect = 0, node = 0;
+    for (;;) {
+        uint32_t kids[4], k = 0, c;
+        RC_RETURN_IF(ctx, node != expect, CORRUPT,
+                     "baked map: geometry %u: the tree reaches node %u where a depth-first walk is at node %u (a "
+                     "baked tree holds each node once, in the order a build writes them)",
+                     (unsigned)g, (unsigned)node, (unsigned)expect);
+        ++expect;
+        for (c = 0; c < 4u; ++c)
+            if (nodes[node].child[c] != RC__WIDE_EMPTY && nodes[node].count[c] == 0) kids[k++] = nodes[node].child[c];
+        if (k > 0) {
+            RC_RETURN_IF(ctx, sp + k - 1u > sizeof stack / sizeof stack[0], CORRUPT,
+                         "baked map: geometry %u: the tree is deeper than a build makes (%u levels at most)",
+                         (unsigned)g, (unsigned)RC__BVH_MAX_DEPTH);
+            while (k > 1u) stack[sp++] = kids[--k];
+            node = kids[0];
+            continue;
+        }
+        if (sp == 0) break;
+        node = stack[--sp];
+    }
+    RC_RETURN_IF(ctx, expect != r->nodes, CORRUPT,
+                 "baked map: geometry %u: the tree reaches %u of its %u nodes", (unsigned)g, (unsigned)expect,
+                 (unsigned)r->nodes);
+    return RC_OK;
+}
+
 static rc_status check_geometry(rc_context *ctx, const unsigned char *blob, uint32_t g, const rc__baked_geom *r)
 {
     const float *v = (const float *)(const void *)(blob + r->off_vertices);
@@ -202,7 +242,7 @@ static rc_status check_geometry(rc_context *ctx, const unsigned char *blob, uint
                      (unsigned long long)i);
     for (i = 0; i < r->nodes; ++i)
         for (c = 0; c < 4u; ++c) RC_TRY(check_slot(ctx, g, r, nodes, (uint32_t)i, c, v, lt));
-    return RC_OK;
+    return check_tree_order(ctx, g, r, nodes);
 }
 
 rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_t bytes, int skip_checksum,
