@@ -1,0 +1,39 @@
+# Coverage-guided fuzzing of what reads untrusted bytes (tests/fuzz). Included
+# by the Makefile.
+#
+#   make fuzz   builds the fuzz targets with clang's libFuzzer, ASan and UBSan
+#               (in $(BUILD)-fuzz: built-in backend only) and runs each for
+#               FUZZ_SECONDS (default 60) from the checked-in corpus
+#               (tests/fuzz/corpus/<name>). What it learns grows
+#               $(BUILD)-fuzz/corpus/<name>; a finding is written to
+#               $(BUILD)-fuzz/findings/ and stops the run with an error. Copy a
+#               finding into tests/fuzz/corpus/<name> once it is fixed: every
+#               build replays that corpus as the test fuzz_<name>_replay.
+#
+# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster; the last
+# needs libcjson-dev).
+
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS ?= baked ply ouster
+FUZZ_BUILD := $(BUILD)-fuzz
+
+.PHONY: fuzz
+fuzz:
+	@command -v clang >/dev/null || { echo "make fuzz needs clang: apt-get install -y clang"; exit 1; }
+	CC=clang $(CMAKE) -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRANGECAST_FUZZ=ON \
+		-DRANGECAST_BUILD_TESTS=OFF -DRANGECAST_BUILD_SHARED=OFF -DRANGECAST_WITH_EMBREE=OFF \
+		-DRANGECAST_WITH_VULKAN=OFF -DRANGECAST_SANITIZE=address,undefined \
+		-DCMAKE_C_FLAGS=-fsanitize=fuzzer-no-link $(CMAKE_FLAGS)
+	$(CMAKE) --build $(FUZZ_BUILD) -j $(JOBS)
+	@mkdir -p $(FUZZ_BUILD)/findings
+	@for t in $(FUZZ_TARGETS); do \
+		exe=$(FUZZ_BUILD)/tests/fuzz/fuzz_$$t; \
+		if [ ! -x $$exe ]; then echo "fuzz: no fuzz_$$t in this build (fuzz_ouster needs libcjson-dev)"; continue; fi; \
+		mkdir -p $(FUZZ_BUILD)/corpus/$$t; \
+		echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
+		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 $$exe -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+			-rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/findings/$$t- \
+			$(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t 2>$(FUZZ_BUILD)/fuzz_$$t.log || \
+			{ tail -n 40 $(FUZZ_BUILD)/fuzz_$$t.log; echo "fuzz: $$t found something: $(FUZZ_BUILD)/findings/"; exit 1; }; \
+		grep -E "stat::number_of_executed_units|stat::new_units_added" $(FUZZ_BUILD)/fuzz_$$t.log | sed "s/^/fuzz: $$t /"; \
+	done
