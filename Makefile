@@ -22,7 +22,7 @@ help:
 	@echo "make cross-aarch64 | cross-armhf | cross-riscv64   cross-build and run the suite under qemu-user"
 	@echo "make test-nothreads   the suite with RANGECAST_WITH_THREADS=OFF"
 	@echo "make static-size      static core library size per target (-Os)"
-	@echo "make fuzz            fuzz the baked-map, PLY and Ouster readers (clang libFuzzer; FUZZ_SECONDS each)"
+	@echo "make fuzz            fuzz the file readers and the traversal (clang libFuzzer; FUZZ_SECONDS each)"
 
 deps-demo:
 	@sh tools/setup-deps.sh demo

@@ -1,5 +1,6 @@
-# Coverage-guided fuzzing of what reads untrusted bytes (tests/fuzz). Included
-# by the Makefile.
+# Coverage-guided fuzzing (tests/fuzz) of what reads untrusted bytes (baked
+# maps, PLY, Ouster metadata) and of the built-in backend's exactness against
+# testing every triangle (trace). Included by the Makefile.
 #
 #   make fuzz   builds the fuzz targets with clang's libFuzzer, ASan and UBSan
 #               (in $(BUILD)-fuzz: built-in backend only) and runs each for
@@ -10,11 +11,11 @@
 #               finding into tests/fuzz/corpus/<name> once it is fixed: every
 #               build replays that corpus as the test fuzz_<name>_replay.
 #
-# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster; the last
+# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace; ouster
 # needs libcjson-dev).
 
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= baked ply ouster
+FUZZ_TARGETS ?= baked ply ouster trace
 FUZZ_BUILD := $(BUILD)-fuzz
 
 .PHONY: fuzz
