@@ -62,7 +62,8 @@ static void test_bad_descs(void **state)
         rc_status want;
     } cases[] = {{0, RC_ERR_STRUCT_SIZE},       {1, RC_ERR_INVALID_ARGUMENT}, {2, RC_ERR_INVALID_ARGUMENT},
                  {3, RC_ERR_INVALID_ARGUMENT},  {4, RC_ERR_NON_FINITE},       {5, RC_ERR_INVALID_ARGUMENT},
-                 {6, RC_ERR_INVALID_ARGUMENT},  {7, RC_ERR_INVALID_ARGUMENT}, {8, RC_ERR_NON_FINITE}};
+                 {6, RC_ERR_INVALID_ARGUMENT},  {7, RC_ERR_INVALID_ARGUMENT}, {8, RC_ERR_NON_FINITE},
+                 {9, RC_ERR_INVALID_ARGUMENT},  {10, RC_ERR_INVALID_ARGUMENT}};
     (void)state;
     for (i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         d = four_beams(8);
@@ -75,6 +76,8 @@ static void test_bad_descs(void **state)
         case 5: d.lidar_to_sensor[10] = -1.0; break;       /* a mirror, not a turn */
         case 6: d.beam_to_lidar[0] = 2.0; break;           /* a scale */
         case 7: d.reserved[3] = 1; break;
+        case 9: d.beam_to_lidar[3] = 1.6e110; break;       /* finite, but inf as a float origin */
+        case 10: d.lidar_to_sensor[11] = -2.0e11; break;   /* 2e8 m: past the 1e8 m a component */
         default: d.lidar_to_sensor[3] = INFINITY; break;
         }
         memset(o, 0xA5, sizeof o);

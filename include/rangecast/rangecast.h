@@ -673,7 +673,9 @@ RC_API rc_ouster_desc rc_ouster_desc_default(void);
  * arrays, shaped beams x columns, range 0.3 .. 120 m (an OS1's; set your
  * model's). beam_offset_m (may be NULL) gets the beam offset above. Checks:
  * counts of at least 1 with at most 2^24 rays, finite angles and matrices,
- * rigid 3x3 parts (orthonormal within 1e-6, no mirror), non-NULL arrays:
+ * rigid 3x3 parts (orthonormal within 1e-6, no mirror), the translations
+ * used (beam_to_lidar's x and z, lidar_to_sensor's) at most 1e11 mm (1e8 m)
+ * a component, non-NULL arrays:
  * RC_ERR_INVALID_ARGUMENT or RC_ERR_NON_FINITE, nothing written. No context:
  * statuses only. Thread-safe. */
 RC_API rc_status rc_ouster_rays(const rc_ouster_desc *desc, rc_rays_desc *rays, float *origins, float *directions,

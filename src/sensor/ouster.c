@@ -8,6 +8,7 @@
 
 #define OUSTER_PI 3.14159265358979323846
 #define MAX_RAYS (1u << 24)
+#define MAX_TRANSLATION_MM 1.0e11 /* 1e8 m */
 
 rc_ouster_desc rc_ouster_desc_default(void)
 {
@@ -73,6 +74,13 @@ rc_status rc_ouster_rays(const rc_ouster_desc *desc, rc_rays_desc *rays, float *
     if (!rigid(b2l) || !rigid(l2s)) return RC_ERR_INVALID_ARGUMENT;
     bx = b2l[3];
     bz = b2l[11];
+    /* the origins become floats and OnDn origins within reach: a finite
+     * 1e110 mm would turn into inf (and a double out of float's range is
+     * undefined to convert); 1e11 mm a component keeps them within 1e9 m */
+    if (!(fabs(bx) <= MAX_TRANSLATION_MM) || !(fabs(bz) <= MAX_TRANSLATION_MM) ||
+        !(fabs(l2s[3]) <= MAX_TRANSLATION_MM) || !(fabs(l2s[7]) <= MAX_TRANSLATION_MM) ||
+        !(fabs(l2s[11]) <= MAX_TRANSLATION_MM))
+        return RC_ERR_INVALID_ARGUMENT;
     for (u = 0; u < desc->beams; ++u) {
         const double ta = -desc->azimuths_deg[u] * (OUSTER_PI / 180.0);
         const double p = desc->altitudes_deg[u] * (OUSTER_PI / 180.0);

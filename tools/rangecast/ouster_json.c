@@ -176,7 +176,7 @@ int rcp_ouster_load(const char *path, rcp_rays *out)
         if (!out->origins || !out->dirs) problem = "out of memory for its rays";
         else if ((st = rc_ouster_rays(&d, &rd, out->origins, out->dirs, NULL)) != RC_OK)
             problem = "rc_ouster_rays refused its values (a transform that is not rigid, a non-finite number, "
-                      "or more than 2^24 rays)";
+                      "a translation past 1e8 m, or more than 2^24 rays)";
     }
     if (!problem) {
         out->width = rd.width;
