@@ -667,12 +667,15 @@ typedef struct rc_ouster_desc {
 
 RC_API rc_ouster_desc rc_ouster_desc_default(void);
 
+/* Most rays (beams * columns) rc_ouster_rays makes: check before allocating. */
+#define RC_OUSTER_MAX_RAYS (1u << 24)
+
 /* Writes the beams * columns rays: origins and directions, 3 floats each
  * (metres; unit vectors), and fills rays (may be NULL) for
  * rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, rays, ...): pointing at the two
  * arrays, shaped beams x columns, range 0.3 .. 120 m (an OS1's; set your
  * model's). beam_offset_m (may be NULL) gets the beam offset above. Checks:
- * counts of at least 1 with at most 2^24 rays, finite angles and matrices,
+ * counts of at least 1 with at most RC_OUSTER_MAX_RAYS, finite angles and matrices,
  * rigid 3x3 parts (orthonormal within 1e-6, no mirror), the translations
  * used (beam_to_lidar's x and z, lidar_to_sensor's) at most 1e11 mm (1e8 m)
  * a component, non-NULL arrays:

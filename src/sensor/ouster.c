@@ -7,7 +7,6 @@
 #include <string.h>
 
 #define OUSTER_PI 3.14159265358979323846
-#define MAX_RAYS (1u << 24)
 #define MAX_TRANSLATION_MM 1.0e11 /* 1e8 m */
 
 rc_ouster_desc rc_ouster_desc_default(void)
@@ -61,8 +60,8 @@ rc_status rc_ouster_rays(const rc_ouster_desc *desc, rc_rays_desc *rays, float *
     uint32_t u, v, k;
     if (desc == NULL || origins == NULL || directions == NULL) return RC_ERR_INVALID_ARGUMENT;
     if (desc->struct_size != sizeof *desc) return RC_ERR_STRUCT_SIZE;
-    if (desc->reserved0 != 0 || desc->beams == 0 || desc->columns == 0 || desc->beams > MAX_RAYS / desc->columns ||
-        desc->altitudes_deg == NULL || desc->azimuths_deg == NULL)
+    if (desc->reserved0 != 0 || desc->beams == 0 || desc->columns == 0 ||
+        desc->beams > RC_OUSTER_MAX_RAYS / desc->columns || desc->altitudes_deg == NULL || desc->azimuths_deg == NULL)
         return RC_ERR_INVALID_ARGUMENT;
     for (k = 0; k < sizeof desc->reserved / sizeof desc->reserved[0]; ++k)
         if (desc->reserved[k] != 0) return RC_ERR_INVALID_ARGUMENT;

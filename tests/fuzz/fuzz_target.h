@@ -23,7 +23,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 /* The input as a file (for readers that take paths): a private file in the
  * temporary directory, rewritten each call, its path in a static buffer.
- * NULL when the file cannot be written. */
+ * NULL when the file cannot be written. Removed at exit. */
 const char *fz_input_file(const uint8_t *data, size_t size, const char *suffix);
 
 #endif

@@ -154,9 +154,9 @@ int rcp_ouster_load(const char *path, rcp_rays *out)
         problem = "beam_altitude_angles and beam_azimuth_angles must be two arrays of numbers of one length";
     } else if (d.columns == 0) {
         problem = "no columns_per_frame and no lidar_mode like \"1024x10\"";
-    } else if (beams > (1u << 24) / d.columns) {
+    } else if (beams > RC_OUSTER_MAX_RAYS / d.columns) {
         /* before the arrays below: rc_ouster_rays would refuse them anyway */
-        problem = "beams x columns_per_frame is more than 2^24 rays (rc_ouster_rays' limit)";
+        problem = "beams x columns_per_frame is more than 2^24 rays (RC_OUSTER_MAX_RAYS)";
     } else if (b2l && !(m = numbers(b2l, &sixteen))) {
         problem = "beam_to_lidar_transform must be 16 numbers (4x4, row by row)";
     } else {
