@@ -11,8 +11,9 @@
 #               finding into tests/fuzz/corpus/<name> once it is fixed: every
 #               build replays that corpus as the test fuzz_<name>_replay.
 #
-# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace; ouster
-# needs libcjson-dev).
+# Installs clang, its libFuzzer runtime and libcjson-dev (tools/setup-deps.sh
+# fuzz), or prints the apt-get line when not root.
+# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace).
 
 FUZZ_SECONDS ?= 60
 FUZZ_TARGETS ?= baked ply ouster trace
@@ -20,7 +21,7 @@ FUZZ_BUILD := $(BUILD)-fuzz
 
 .PHONY: fuzz
 fuzz:
-	@command -v clang >/dev/null || { echo "make fuzz needs clang: apt-get install -y clang"; exit 1; }
+	@sh tools/setup-deps.sh fuzz
 	CC=clang $(CMAKE) -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DRANGECAST_FUZZ=ON \
 		-DRANGECAST_BUILD_TESTS=OFF -DRANGECAST_BUILD_SHARED=OFF -DRANGECAST_WITH_EMBREE=OFF \
 		-DRANGECAST_WITH_VULKAN=OFF -DRANGECAST_SANITIZE=address,undefined \

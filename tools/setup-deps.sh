@@ -1,7 +1,7 @@
 #!/bin/sh
 # Installs the Debian 12 packages a make target needs, or prints the exact
 # apt-get line when not root.
-# Usage: tools/setup-deps.sh demo|test|cross|all
+# Usage: tools/setup-deps.sh demo|test|fuzz|cross|all
 #                            |cross-aarch64|cross-armhf|cross-riscv64|multiarch-arm64
 #   cross-<target>   that target's cross gcc, cross libc and qemu-user (make cross-<target>)
 #   multiarch-arm64  arm64 packages next to the amd64 ones (dpkg --add-architecture
@@ -16,6 +16,8 @@ demo="$base libpng-dev libassimp-dev libmeshoptimizer-dev libcjson-dev"
 test="$demo python3-matplotlib python3-numpy libcmocka-dev libembree-dev libvulkan-dev mesa-vulkan-drivers glslang-tools clang valgrind"
 # qemu-user runs the cross-built tests; xz-utils unpacks the cmocka source
 # package that make cross-armhf / cross-riscv64 build (toolchains/cmocka-from-source.sh).
+# make fuzz: clang's libFuzzer runtime comes in its own package
+fuzz="$base clang libclang-rt-14-dev libcjson-dev"
 cross_aarch64="$base gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user"
 cross_armhf="$base gcc-arm-linux-gnueabihf libc6-dev-armhf-cross qemu-user xz-utils"
 cross_riscv64="$base gcc-riscv64-linux-gnu libc6-dev-riscv64-cross qemu-user xz-utils"
@@ -27,13 +29,14 @@ foreign=""
 case "$profile" in
   demo) want=$demo ;;
   test) want=$test ;;
+  fuzz) want=$fuzz ;;
   cross) want=$cross ;;
   cross-aarch64) want=$cross_aarch64 ;;
   cross-armhf) want=$cross_armhf ;;
   cross-riscv64) want=$cross_riscv64 ;;
   multiarch-arm64) want=$multiarch_arm64; foreign=arm64 ;;
-  all) want="$test $cross" ;;
-  *) echo "usage: $0 demo|test|cross|all|cross-aarch64|cross-armhf|cross-riscv64|multiarch-arm64" >&2; exit 2 ;;
+  all) want="$test $fuzz $cross" ;;
+  *) echo "usage: $0 demo|test|fuzz|cross|all|cross-aarch64|cross-armhf|cross-riscv64|multiarch-arm64" >&2; exit 2 ;;
 esac
 
 # The Vulkan ray query tests' driver (tools/fetch-lavapipe-rq.sh): unpacked
