@@ -60,23 +60,26 @@ ubsan: asan
 
 # Every cmocka runner under valgrind (quick sizes; the Vulkan backend is left
 # out, runners and shared suites alike: lavapipe's and LLVM's own memory and
-# glibc's dlopen of the driver are not ours to judge). ctest -T memcheck
-# would need CTest's dashboard files, so the runners are called directly: the
-# test_* executables ctest lists for this build (a runner whose test was
-# removed stays in $(BUILD)/tests and is not run), scripts left out.
+# glibc's dlopen of the driver are not ours to judge), then every fuzz
+# target's replay over its checked-in corpus. ctest -T memcheck would need
+# CTest's dashboard files, so the programs are called directly: the test_*
+# and fuzz_*_replay executables ctest lists for this build (a runner whose test
+# was removed stays in $(BUILD)/tests and is not run), scripts left out.
 # VALGRIND_TESTS (a ctest -R regex) picks some, e.g. VALGRIND_TESTS=test_arena.
 VALGRIND_TESTS ?= .
 valgrind: build
 	@command -v valgrind >/dev/null || { echo "valgrind: apt-get install -y valgrind"; exit 1; }
-	cd $(BUILD)/tests && tests=$$(ctest -N -R '$(VALGRIND_TESTS)' | sed -n 's/^ *Test *#[0-9]*: \(test_[A-Za-z0-9_]*\)$$/\1/p') && \
-	[ -n "$$tests" ] || { echo "valgrind: ctest lists no test_* runner in $(BUILD)/tests"; exit 1; }; \
+	cd $(BUILD) && tests=$$(ctest -N -R '$(VALGRIND_TESTS)' | sed -n 's/^ *Test *#[0-9]*: \(test_[A-Za-z0-9_]*\|fuzz_[a-z]*_replay\)$$/\1/p') && \
+	[ -n "$$tests" ] || { echo "valgrind: ctest lists no test_* runner or fuzz replay in $(BUILD)"; exit 1; }; \
 	for t in $$tests; do \
 		case $$t in *vulkan*) continue ;; esac; \
-		[ -f $$t ] && [ -x $$t ] && [ "$$(head -c 4 $$t)" = "$$(printf '\177ELF')" ] || continue; \
+		exe=./tests/$$t; args=; \
+		case $$t in fuzz_*_replay) name=$${t#fuzz_}; exe=./tests/fuzz/$$t; args=$(CURDIR)/tests/fuzz/corpus/$${name%_replay} ;; esac; \
+		[ -f $$exe ] && [ -x $$exe ] && [ "$$(head -c 4 $$exe)" = "$$(printf '\177ELF')" ] || continue; \
 		echo "valgrind $$t"; \
 		RC_TEST_QUICK=1 RC_TEST_SKIP_BACKENDS=vulkan valgrind -q --leak-check=full --errors-for-leak-kinds=definite,indirect \
 			--suppressions=$(CURDIR)/tests/valgrind.supp \
-			--error-exitcode=1 ./$$t >/dev/null || { echo "valgrind: $$t failed"; exit 1; }; \
+			--error-exitcode=1 $$exe $$args >/dev/null || { echo "valgrind: $$t failed"; exit 1; }; \
 	done; echo "valgrind: no errors, no leaks"
 
 bench: build
