@@ -2,10 +2,17 @@
  * on a coarse grid (so triangles share edges and vertices, lie in one plane,
  * collapse to lines and points, and rays start on them and graze them), one
  * sensor position and up to 64 rays, as an O1Dn sensor (the packet
- * traversal) or an OnDn one (single rays). Promised: every ray's hit, and the
- * triangle it names, are exactly those of testing every triangle with the
- * same watertight test and tie rule, one by one: the tree's box tests only
- * ever skip triangles that cannot win. */
+ * traversal) or an OnDn one (single rays). The triangles go into one mesh or
+ * are split over up to four, and the scene may hold up to four instances of
+ * a scene of those meshes (turned, scaled, mirrored: the two-level tree), the
+ * meshes themselves beside them or not. The traversals that take turns on
+ * large maps can be forced. Promised: every ray's hit, and the triangle,
+ * mesh and instance it names, are exactly those of testing every triangle of
+ * every mesh and instance with the same watertight test and tie rule, one by
+ * one (instances with the ray turned into their frame as the library turns
+ * it): the trees' box tests only ever skip triangles that cannot win. A hit's
+ * point lies at its range along its ray, and its normal is a unit vector
+ * facing the sensor. */
 #include "fuzz_target.h"
 
 #include <math.h>
@@ -13,13 +20,22 @@
 
 #include "rangecast/rangecast.h"
 #include "bvh/intersect.h"
+#include "core/context.h"
+#include "scene/scene.h"
 #include "sensor/sensor.h"
 
 #define MAX_TRIS 256u
 #define MAX_RAYS 64u
+#define MAX_MESHES 4u
+#define MAX_INSTANCES 4u
 #define RANGE_MAX 1.0e6f
 
+/* The flags byte: bit 0 OnDn, bits 1-4 the grid step, bit 5 every mesh
+ * counts as large (the traversals take turns), bits 6-7 the layout. */
+enum layout { ONE_MESH, MESHES, MESHES_AND_INSTANCES, INSTANCES_ONLY };
+
 static rc_context *ctx;
+static uint64_t default_large_bytes;
 
 typedef struct reader {
     const uint8_t *p;
@@ -47,43 +63,113 @@ static void setup(void)
     cd.thread_count = 1;
     cd.memory_size = 8u << 20;
     FZ_REQUIRE(rc_context_create(&cd, &ctx) == RC_OK, "context");
+    default_large_bytes = ctx->large_mesh_bytes;
     atexit(teardown);
 }
 
-/* The nearest hit by testing every triangle, as rc__mesh_intersect ranks them. */
-static rc__hit brute_nearest(const float *verts, uint32_t tris, const float org[3], const float dir[3])
+typedef struct mesh_split {
+    uint32_t count;
+    uint32_t first[MAX_MESHES + 1]; /* mesh m holds triangles first[m] .. first[m+1]-1 */
+} mesh_split;
+
+/* Offers every triangle of every mesh to h, for a ray already in the meshes'
+ * frame, as rc__mesh_intersect ranks them. */
+static void offer_all(rc__hit *h, const float *verts, const mesh_split *ms, const rc__ray *ray, uint32_t inst)
+{
+    uint32_t m, i;
+    for (m = 0; m < ms->count; ++m)
+        for (i = ms->first[m]; i < ms->first[m + 1]; ++i) {
+            float t, u, v;
+            const float *a = verts + 9u * i;
+            const uint32_t prim = i - ms->first[m];
+            if (rc__tri_intersect(ray, a, a + 3, a + 6, &t, &u, &v)) rc__hit_offer(h, t, u, v, prim, prim, m, inst);
+        }
+}
+
+/* The nearest hit by testing everything: the scene's own meshes, and each
+ * instance's meshes with the ray turned into its frame by the same float
+ * operations as the library's two-level traversal. */
+static rc__hit brute_nearest(const rc_scene *scene, int own_meshes, const float *verts, const mesh_split *ms,
+                             const float org[3], const float dir[3])
 {
     rc__ray ray;
     rc__hit h;
-    uint32_t i;
+    uint32_t k;
     rc__ray_prepare(&ray, org, dir);
     h.t = RANGE_MAX;
     h.u = h.v = 0.0f;
     h.prim = h.geom = h.inst = h.slot = RC_INVALID_ID;
-    for (i = 0; i < tris; ++i) {
-        float t, u, v;
-        const float *a = verts + 9u * i;
-        if (rc__tri_intersect(&ray, a, a + 3, a + 6, &t, &u, &v)) rc__hit_offer(&h, t, u, v, i, i, 0u, RC_INVALID_ID);
+    if (own_meshes) offer_all(&h, verts, ms, &ray, RC_INVALID_ID);
+    for (k = 0; k < scene->inst_count; ++k) {
+        const rc__instance *in = &scene->insts[k];
+        rc__ray local;
+        float o[3], d[3];
+        rc__rot_apply_f(in->to_local.r, ray.org, o);
+        o[0] += in->to_local.t[0];
+        o[1] += in->to_local.t[1];
+        o[2] += in->to_local.t[2];
+        rc__rot_apply_f(in->to_local.r, ray.dir, d);
+        rc__ray_prepare(&local, o, d);
+        offer_all(&h, verts, ms, &local, k);
     }
     return h;
+}
+
+/* Adds the split meshes to scene (copied, so the arrays can be reused). */
+static void add_meshes(rc_scene *scene, const float *verts, const uint32_t *indices, const mesh_split *ms)
+{
+    uint32_t m, geom;
+    for (m = 0; m < ms->count; ++m) {
+        rc_mesh_desc md = rc_mesh_desc_default();
+        const uint32_t n = ms->first[m + 1] - ms->first[m];
+        md.flags = RC_MESH_COPY;
+        md.vertices = verts + 9u * ms->first[m];
+        md.vertex_count = 3u * n;
+        md.indices = indices;
+        md.triangle_count = n;
+        FZ_REQUIRE(rc_scene_add_mesh(scene, &md, &geom) == RC_OK, "a mesh on the grid is accepted");
+        FZ_REQUIRE(geom == m, "geometry ids count up");
+    }
+}
+
+static rc_scene *new_scene(const mesh_split *ms, uint32_t tris, uint32_t meshes, uint32_t instances)
+{
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_scene *scene = NULL;
+    sd.max_geometries = meshes;
+    sd.max_instances = instances;
+    sd.max_triangles = meshes ? tris : 0u;
+    sd.max_vertices = meshes ? 3u * tris : 0u;
+    sd.max_copied_triangles = meshes ? tris : 0u;
+    (void)ms;
+    FZ_REQUIRE(rc_scene_create(ctx, &sd, &scene) == RC_OK, "scene");
+    return scene;
+}
+
+/* A scale from one byte: mirrors, powers of two and others. */
+static float scale_of(uint8_t b)
+{
+    static const float scales[8] = {1.0f, 2.0f, 0.5f, -1.0f, 3.0f, 0.25f, -1.5f, 1.0f / 3.0f};
+    return scales[b & 7u];
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static float verts[MAX_TRIS * 9u], origins[MAX_RAYS * 3u], dirs[MAX_RAYS * 3u], ranges[MAX_RAYS];
-    static uint32_t indices[MAX_TRIS * 3u], prims[MAX_RAYS];
+    static float points[MAX_RAYS * 3u], normals[MAX_RAYS * 3u];
+    static uint32_t indices[MAX_TRIS * 3u], prims[MAX_RAYS], geoms[MAX_RAYS], insts[MAX_RAYS];
     static uint8_t hits[MAX_RAYS];
     reader r;
     uint8_t flags;
-    int ondn;
+    int ondn, own_meshes;
+    enum layout layout;
     float scale, pos[3];
-    uint32_t tris, rays, i, k, geom;
-    rc_scene_desc sd = rc_scene_desc_default();
-    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t tris, rays, i, k, m, instances = 0;
+    mesh_split ms;
     rc_rays_desc rd = rc_rays_desc_default();
     rc_results res = rc_results_default();
     rc_pose pose = rc_pose_identity();
-    rc_scene *scene = NULL;
+    rc_scene *scene = NULL, *source = NULL;
     rc_sensor *sensor = NULL;
     rc_status st;
     if (ctx == NULL) setup();
@@ -92,6 +178,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     flags = next(&r);
     ondn = flags & 1u;
     scale = ldexpf(1.0f, (int)((flags >> 1) & 15u) - 9); /* grid steps 1/512 .. 64 */
+    ctx->large_mesh_bytes = (flags & 32u) ? 0u : default_large_bytes;
+    layout = (enum layout)(flags >> 6);
     tris = 1u + next(&r) % MAX_TRIS;
     rays = 1u + next(&r) % MAX_RAYS;
     for (k = 0; k < 3u; ++k) pos[k] = coord(&r, scale);
@@ -103,46 +191,92 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     for (i = 0; i < tris * 9u; ++i) verts[i] = coord(&r, scale);
     for (i = 0; i < tris * 3u; ++i) indices[i] = i;
 
-    sd.max_geometries = 1;
-    sd.max_triangles = tris;
-    sd.max_vertices = 3u * tris;
-    sd.max_copied_triangles = tris;
-    md.flags = RC_MESH_COPY;
-    md.vertices = verts;
-    md.vertex_count = 3u * tris;
-    md.indices = indices;
-    md.triangle_count = tris;
+    /* the meshes: tris split into nearly equal runs */
+    ms.count = layout == ONE_MESH ? 1u : 1u + next(&r) % MAX_MESHES;
+    if (ms.count > tris) ms.count = tris;
+    for (m = 0; m <= ms.count; ++m) ms.first[m] = (uint32_t)((uint64_t)tris * m / ms.count);
+    own_meshes = layout != INSTANCES_ONLY;
+
+    if (layout == MESHES_AND_INSTANCES || layout == INSTANCES_ONLY) {
+        instances = (layout == INSTANCES_ONLY ? 1u : 0u) + next(&r) % (MAX_INSTANCES + 1u);
+        if (instances > MAX_INSTANCES) instances = MAX_INSTANCES;
+        source = new_scene(&ms, tris, ms.count, 0u);
+        add_meshes(source, verts, indices, &ms);
+        FZ_REQUIRE(rc_scene_commit(source) == RC_OK, "the instances' source commits");
+    }
+    scene = new_scene(&ms, tris, own_meshes ? ms.count : 0u, instances);
+    if (own_meshes) add_meshes(scene, verts, indices, &ms);
+    for (k = 0; k < instances; ++k) {
+        rc_instance_desc id = rc_instance_desc_default();
+        float q[4], n2 = 0.0f;
+        uint32_t inst_id;
+        id.source = source;
+        for (m = 0; m < 3u; ++m) id.transform.position[m] = coord(&r, scale);
+        for (m = 0; m < 4u; ++m) {
+            q[m] = (float)(int8_t)next(&r);
+            n2 += q[m] * q[m];
+        }
+        if (n2 == 0.0f) q[3] = n2 = 1.0f;
+        for (m = 0; m < 4u; ++m) id.transform.orientation[m] = q[m] / sqrtf(n2);
+        for (m = 0; m < 3u; ++m) id.scale[m] = scale_of(next(&r));
+        st = rc_scene_add_instance(scene, &id, &inst_id);
+        FZ_REQUIRE(st == RC_OK, "an instance on the grid is accepted");
+        FZ_REQUIRE(inst_id == k, "instance ids count up");
+    }
+    FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "commit");
+
     rd.common.range_min = 0.0f;
     rd.common.range_max = RANGE_MAX;
     rd.directions = dirs;
     rd.origins = ondn ? origins : NULL;
     rd.ray_count = rays;
-    FZ_REQUIRE(rc_scene_create(ctx, &sd, &scene) == RC_OK, "scene");
-    FZ_REQUIRE(rc_scene_add_mesh(scene, &md, &geom) == RC_OK, "a mesh on the grid is accepted");
-    FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "commit");
     st = rc_sensor_create_rays(ctx, ondn ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &rd, &sensor);
     FZ_REQUIRE(st == RC_OK, "sensor");
     memcpy(pose.position, pos, sizeof pos);
-    res.attributes = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_PRIM_IDS;
+    res.attributes = RC_ATTR_ALL;
     res.hits = hits;
     res.ranges = ranges;
+    res.points = points;
+    res.normals = normals;
     res.prim_ids = prims;
+    res.geom_ids = geoms;
+    res.inst_ids = insts;
     res.capacity = rays;
     FZ_REQUIRE(rc_simulate(ctx, scene, sensor, &pose, 1, &res) == RC_OK, "simulate");
     for (i = 0; i < rays; ++i) {
         /* the rays as the library traces them: its unit directions, the
          * pose's translation (the turn is the identity) */
+        const float *d = sensor->directions + 3u * i, *o = origins + 3u * i, *p = points + 3u * i;
+        const float *nv = normals + 3u * i;
         float org[3];
+        double len2 = 0.0, facing = 0.0, off2 = 0.0;
         rc__hit h;
-        for (k = 0; k < 3u; ++k) org[k] = pos[k] + origins[3u * i + k];
-        h = brute_nearest(verts, tris, org, sensor->directions + 3u * i);
-        if ((h.prim != RC_INVALID_ID) != (hits[i] != 0) || (hits[i] && prims[i] != h.prim)) {
-            fprintf(stderr, "ray %u: library hit %u prim %u range %.9g; every triangle: prim %u t %.9g\n", (unsigned)i,
-                    (unsigned)hits[i], (unsigned)prims[i], (double)ranges[i], (unsigned)h.prim, (double)h.t);
-            FZ_REQUIRE(0, "the tree's nearest hit is the nearest of all triangles");
+        for (k = 0; k < 3u; ++k) org[k] = pos[k] + o[k];
+        h = brute_nearest(scene, own_meshes, verts, &ms, org, d);
+        if ((h.prim != RC_INVALID_ID) != (hits[i] != 0) ||
+            (hits[i] && (prims[i] != h.prim || geoms[i] != h.geom || insts[i] != h.inst))) {
+            fprintf(stderr,
+                    "ray %u: library hit %u prim %u geom %u inst %u range %.9g; every triangle: prim %u geom %u "
+                    "inst %u t %.9g\n",
+                    (unsigned)i, (unsigned)hits[i], (unsigned)prims[i], (unsigned)geoms[i], (unsigned)insts[i],
+                    (double)ranges[i], (unsigned)h.prim, (unsigned)h.geom, (unsigned)h.inst, (double)h.t);
+            FZ_REQUIRE(0, "the trees' nearest hit is the nearest of all triangles");
         }
+        if (!hits[i]) continue;
+        for (k = 0; k < 3u; ++k) {
+            const double want = (double)o[k] + (double)d[k] * (double)ranges[i];
+            off2 += (p[k] - want) * (p[k] - want);
+            len2 += (double)nv[k] * nv[k];
+            facing += (double)nv[k] * d[k];
+        }
+        FZ_REQUIRE(ranges[i] >= 0.0f && ranges[i] <= RANGE_MAX, "a hit's range lies in the sensor's interval");
+        FZ_REQUIRE(sqrt(off2) <= 1e-5 * ((double)ranges[i] + fabs(o[0]) + fabs(o[1]) + fabs(o[2])) + 1e-30,
+                   "a hit's point lies at its range along its ray");
+        FZ_REQUIRE(fabs(len2 - 1.0) <= 1e-5, "a hit's normal is a unit vector");
+        FZ_REQUIRE(facing <= 1e-6, "a hit's normal faces the sensor");
     }
     FZ_REQUIRE(rc_sensor_destroy(sensor) == RC_OK, "sensor destroy");
     FZ_REQUIRE(rc_scene_destroy(scene) == RC_OK, "scene destroy");
+    if (source) FZ_REQUIRE(rc_scene_destroy(source) == RC_OK, "source destroy");
     return 0;
 }
