@@ -33,9 +33,16 @@
 #pragma STDC FP_CONTRACT OFF
 #endif
 
-/* Ize's bound: slab exit distances are scaled by 1 + 2 * gamma(3) (rounded up)
- * so rounding in (plane - org) * inv_dir can never reject a box the ray meets. */
-#define RC__SLAB_FAR_SCALE (1.0f + 4.0f * FLT_EPSILON)
+/* Slab exit distances (and the nearest hit a box is compared with) are scaled
+ * by this. Ize's bound, 1 + 2 * gamma(3), is enough for rounding in
+ * (plane - org) * inv_dir never to reject a box the ray meets; but a box is
+ * also compared with a triangle's t from the watertight test, which carries
+ * rounding of its own (a few ulps for a triangle not seen edge-on: 5.4 ulps
+ * in a case fuzz_trace found, where the same triangle in an instance lay in a
+ * box whose entry rounded above it). 32 ulps keep such a box, so a tie
+ * between meshes or instances goes by the key whatever the order they are
+ * searched in; it costs nothing measurable (docs/benchmarks.md). */
+#define RC__SLAB_FAR_SCALE (1.0f + 32.0f * FLT_EPSILON)
 
 /* Per-ray constants of the slab test. A node is read as it is laid out
  * (bmin[3], index, bmax[3], count): for each axis, the plane the ray enters by
