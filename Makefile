@@ -6,7 +6,7 @@ CMAKE_FLAGS ?=
 CMAKE := cmake
 SAN_BUILD := $(BUILD)-asan
 
-.PHONY: all build deps-demo deps-test demo test test-fast asan ubsan sanitize valgrind install bench clean help
+.PHONY: all build deps-demo deps-test demo test test-fast asan ubsan sanitize tsan valgrind install bench clean help
 
 all: build
 
@@ -17,6 +17,7 @@ help:
 	@echo "make test-fast  run the tests once (no sanitizer pass)"
 	@echo "make asan       tests under AddressSanitizer + UndefinedBehaviorSanitizer"
 	@echo "make valgrind   tests under valgrind memcheck (leaks are errors)"
+	@echo "make tsan       tests under ThreadSanitizer (built-in backend; a data race fails the test)"
 	@echo "make bench      rangecast bench on the standard workload (1M-triangle sphere)"
 	@echo "make install    install into PREFIX (default /usr/local)"
 	@echo "make cross-aarch64 | cross-armhf | cross-riscv64   cross-build and run the suite under qemu-user"
@@ -58,6 +59,19 @@ asan sanitize:
 
 ubsan: asan
 
+# The suite under ThreadSanitizer: the thread pool, the parallel build and
+# contexts used from several threads. A reported race makes the program exit
+# non-zero, so its test fails. Built-in backend only: Embree's TBB and
+# lavapipe's threads synchronise in ways TSan cannot see without their own
+# instrumented builds.
+TSAN_BUILD := $(BUILD)-tsan
+tsan: deps-test
+	$(CMAKE) -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=Debug -DRANGECAST_SANITIZE=thread \
+		-DRANGECAST_BUILD_SHARED=OFF -DRANGECAST_WITH_EMBREE=OFF -DRANGECAST_WITH_VULKAN=OFF $(CMAKE_FLAGS)
+	$(CMAKE) --build $(TSAN_BUILD) -j $(JOBS)
+	cd $(TSAN_BUILD) && TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 RC_TEST_QUICK=1 \
+		ctest --output-on-failure -j $(JOBS)
+
 # Every cmocka runner under valgrind (quick sizes; the Vulkan backend is left
 # out, runners and shared suites alike: lavapipe's and LLVM's own memory and
 # glibc's dlopen of the driver are not ours to judge), then every fuzz
@@ -90,6 +104,6 @@ install: build
 	$(CMAKE) --install $(BUILD) --prefix $(PREFIX)
 
 clean:
-	rm -rf $(BUILD) $(BUILD)-demo $(SAN_BUILD) out
+	rm -rf $(BUILD) $(BUILD)-demo $(SAN_BUILD) $(TSAN_BUILD) out
 
 -include mk/*.mk
