@@ -2,7 +2,8 @@
  * on a coarse grid (so triangles share edges and vertices, lie in one plane,
  * collapse to lines and points, and rays start on them and graze them), one
  * sensor position and up to 64 rays, as an O1Dn sensor (the packet
- * traversal) or an OnDn one (single rays). The triangles go into one mesh or
+ * traversal) or an OnDn one (single rays), or a spherical or pinhole grid of
+ * up to 8 x 8 rays (the packets over the grid's tiles). The triangles go into one mesh or
  * are split over up to four, and the scene may hold up to four instances of
  * a scene of those meshes (turned, scaled, mirrored: the two-level tree), the
  * meshes themselves beside them or not. The traversals that take turns on
@@ -146,6 +147,44 @@ static rc_scene *new_scene(const mesh_split *ms, uint32_t tris, uint32_t meshes,
     return scene;
 }
 
+/* A grid sensor from the input's last bytes, or NULL where the input keeps
+ * the rays it gave (kind 0) or its grid is one the API refuses (a finding
+ * only if the refusal is not the documented one). */
+static rc_sensor *grid_sensor(reader *r, uint32_t *rays)
+{
+    const uint8_t kind = next(r) % 4u;
+    const uint32_t rows = 1u + next(r) % 8u, cols = 1u + next(r) % 8u;
+    rc_sensor *sensor = NULL;
+    rc_status st = RC_OK;
+    if (kind == 1u) {
+        rc_spherical_desc d = rc_spherical_desc_default();
+        d.common.range_min = 0.0f;
+        d.common.range_max = RANGE_MAX;
+        d.theta.min = (float)(int8_t)next(r) * (3.14159265f / 64.0f);
+        d.theta.increment = (float)(int8_t)next(r) * (3.14159265f / 512.0f);
+        d.theta.count = cols;
+        d.phi.min = (float)(int8_t)next(r) * (3.14159265f / 256.0f);
+        d.phi.increment = (float)(int8_t)next(r) * (3.14159265f / 1024.0f);
+        d.phi.count = rows;
+        st = rc_sensor_create_spherical(ctx, &d, &sensor);
+    } else if (kind >= 2u) {
+        rc_pinhole_desc d = rc_pinhole_desc_default();
+        d.frame = kind == 3u ? RC_PINHOLE_FRAME_OPTICAL : RC_PINHOLE_FRAME_BODY;
+        d.common.range_min = 0.0f;
+        d.common.range_max = RANGE_MAX;
+        d.width = cols;
+        d.height = rows;
+        d.fx = 1.0f + (float)next(r);
+        d.fy = 1.0f + (float)next(r);
+        d.cx = (float)(int8_t)next(r) * 0.25f;
+        d.cy = (float)(int8_t)next(r) * 0.25f;
+        st = rc_sensor_create_pinhole(ctx, &d, &sensor);
+    }
+    FZ_REQUIRE(st == RC_OK || st == RC_ERR_INVALID_ARGUMENT, "a grid sensor is made or refused as documented");
+    if (sensor) *rays = rows * cols;
+    return sensor;
+}
+
 /* A scale from one byte: mirrors, powers of two and others. */
 static float scale_of(uint8_t b)
 {
@@ -225,13 +264,20 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "commit");
 
+    sensor = grid_sensor(&r, &rays);
+    if (sensor) { /* one origin: the OnDn offsets read above go unused */
+        ondn = 0;
+        memset(origins, 0, sizeof origins);
+    }
     rd.common.range_min = 0.0f;
     rd.common.range_max = RANGE_MAX;
     rd.directions = dirs;
     rd.origins = ondn ? origins : NULL;
     rd.ray_count = rays;
-    st = rc_sensor_create_rays(ctx, ondn ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &rd, &sensor);
-    FZ_REQUIRE(st == RC_OK, "sensor");
+    if (sensor == NULL) {
+        st = rc_sensor_create_rays(ctx, ondn ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &rd, &sensor);
+        FZ_REQUIRE(st == RC_OK, "sensor");
+    }
     memcpy(pose.position, pos, sizeof pos);
     res.attributes = RC_ATTR_ALL;
     res.hits = hits;
