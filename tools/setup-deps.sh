@@ -14,10 +14,10 @@ demo="$base libpng-dev libassimp-dev libmeshoptimizer-dev libcjson-dev"
 # python3-matplotlib: tools/chart.py (make accuracy-docs); python3-numpy: the
 # Python binding and its tests (bindings/python)
 test="$demo python3-matplotlib python3-numpy libcmocka-dev libembree-dev libvulkan-dev mesa-vulkan-drivers glslang-tools clang valgrind"
-# qemu-user runs the cross-built tests; xz-utils unpacks the cmocka source
-# package that make cross-armhf / cross-riscv64 build (toolchains/cmocka-from-source.sh).
 # make fuzz: clang's libFuzzer runtime comes in its own package
 fuzz="$base clang libclang-rt-14-dev libcjson-dev"
+# qemu-user runs the cross-built tests; xz-utils unpacks the cmocka source
+# package that make cross-armhf / cross-riscv64 build (toolchains/cmocka-from-source.sh).
 cross_aarch64="$base gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user"
 cross_armhf="$base gcc-arm-linux-gnueabihf libc6-dev-armhf-cross qemu-user xz-utils"
 cross_riscv64="$base gcc-riscv64-linux-gnu libc6-dev-riscv64-cross qemu-user xz-utils"

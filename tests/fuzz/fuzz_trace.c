@@ -3,10 +3,10 @@
  * collapse to lines and points, and rays start on them and graze them), one
  * sensor position and up to 64 rays, as an O1Dn sensor (the packet
  * traversal) or an OnDn one (single rays), or a spherical or pinhole grid of
- * up to 8 x 8 rays (the packets over the grid's tiles). The triangles go into one mesh or
- * are split over up to four, and the scene may hold up to four instances of
- * a scene of those meshes (turned, scaled, mirrored: the two-level tree), the
- * meshes themselves beside them or not. The traversals that take turns on
+ * up to 8 x 8 rays (the packets over the grid's tiles). The triangles go
+ * into one mesh or are split over up to four, and the scene may hold up to
+ * four instances of a scene of those meshes (turned, scaled, mirrored: the
+ * two-level tree), the meshes themselves beside them or not. The traversals that take turns on
  * large maps can be forced. Promised: every ray's hit, and the triangle,
  * mesh and instance it names, are exactly those of testing every triangle of
  * every mesh and instance with the same watertight test and tie rule, one by
@@ -133,7 +133,7 @@ static void add_meshes(rc_scene *scene, const float *verts, const uint32_t *indi
     }
 }
 
-static rc_scene *new_scene(const mesh_split *ms, uint32_t tris, uint32_t meshes, uint32_t instances)
+static rc_scene *new_scene(uint32_t tris, uint32_t meshes, uint32_t instances)
 {
     rc_scene_desc sd = rc_scene_desc_default();
     rc_scene *scene = NULL;
@@ -142,7 +142,6 @@ static rc_scene *new_scene(const mesh_split *ms, uint32_t tris, uint32_t meshes,
     sd.max_triangles = meshes ? tris : 0u;
     sd.max_vertices = meshes ? 3u * tris : 0u;
     sd.max_copied_triangles = meshes ? tris : 0u;
-    (void)ms;
     FZ_REQUIRE(rc_scene_create(ctx, &sd, &scene) == RC_OK, "scene");
     return scene;
 }
@@ -239,11 +238,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     if (layout == MESHES_AND_INSTANCES || layout == INSTANCES_ONLY) {
         instances = (layout == INSTANCES_ONLY ? 1u : 0u) + next(&r) % (MAX_INSTANCES + 1u);
         if (instances > MAX_INSTANCES) instances = MAX_INSTANCES;
-        source = new_scene(&ms, tris, ms.count, 0u);
+        source = new_scene(tris, ms.count, 0u);
         add_meshes(source, verts, indices, &ms);
         FZ_REQUIRE(rc_scene_commit(source) == RC_OK, "the instances' source commits");
     }
-    scene = new_scene(&ms, tris, own_meshes ? ms.count : 0u, instances);
+    scene = new_scene(tris, own_meshes ? ms.count : 0u, instances);
     if (own_meshes) add_meshes(scene, verts, indices, &ms);
     for (k = 0; k < instances; ++k) {
         rc_instance_desc id = rc_instance_desc_default();
