@@ -127,6 +127,12 @@ struct Ray {
     float sx, sy, sz;
 };
 
+/* The slack of box tests and of dropping stacked boxes: 1 + 32 ulps, as the
+ * CPU's RC__SLAB_FAR_SCALE (src/bvh/intersect.h): it covers the slab test's
+ * rounding and the triangle test's, so a tie between meshes or instances is
+ * never culled by a box whose entry rounds just above the hit. */
+const float SLAB_FAR_SCALE = 1.0000038;
+
 /* Slab-test constants: reciprocal direction, which plane is entered first,
  * and the axes the ray is parallel to. */
 struct Slab {
@@ -201,7 +207,7 @@ bool node_hit(Node n, Slab s, float tmax, out float tnear)
     float tn = max(max(a.x, a.y), max(a.z, 0.0));
     float tf = min(min(b.x, b.y), min(b.z, tmax));
     tnear = tn;
-    return tn <= tf * 1.0000020;
+    return tn <= tf * SLAB_FAR_SCALE;
 }
 
 /* ---- watertight triangle test (rc__tri_intersect) ------------------------- */
@@ -410,7 +416,7 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
                 alive = false;
                 while (sp > 0u && !alive) {
                     --sp;
-                    if (stk_t[sp] <= h.t * 1.0000020) { /* the box test's slack: ties are never culled */
+                    if (stk_t[sp] <= h.t * SLAB_FAR_SCALE) { /* the box test's slack: ties are never culled */
                         n = load_node(g.node_base + stk_n[sp]);
                         alive = true;
                     }
@@ -435,7 +441,7 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
         alive = false;
         while (sp > 0u && !alive) {
             --sp;
-            if (stk_t[sp] <= h.t * 1.0000020) { /* the box test's slack: ties are never culled */
+            if (stk_t[sp] <= h.t * SLAB_FAR_SCALE) { /* the box test's slack: ties are never culled */
                 n = load_node(g.node_base + stk_n[sp]);
                 alive = true;
             }
