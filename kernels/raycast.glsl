@@ -117,6 +117,74 @@ vec3 load_vertex(uint i)
 #endif
 }
 
+/* ---- correctly rounded float division ------------------------------------ */
+
+/* a / b rounded to nearest, as the CPU divides. A shader's float division may
+ * be off by up to 2.5 ulps (Vulkan's bound for OpFDiv; NVIDIA's driver uses
+ * it): on an H100 a ray along a box's diagonal got a shear of 0.99999994
+ * instead of 1 and slipped past the corner it touches (test_stability,
+ * axis_parallel). The rounded quotient is the candidate with the smallest
+ * remainder |a - q b|, so the driver's quotient is moved an ulp at a time while
+ * a neighbour's remainder is smaller. With float64 each remainder is exact (a
+ * float product has 48 bits); without it, a - (p + e) from Dekker's exact
+ * product. Zero, subnormal, infinite and NaN quotients are left as they are. */
+#if RC_FP64
+#define REMAINDER double
+double remainder_of(float a, float b, float q)
+{
+    precise double r = double(a) - double(q) * double(b);
+    return abs(r);
+}
+#else
+/* a * b = p + e exactly (Dekker's product with Veltkamp's split; no FMA). */
+void two_prod(float a, float b, out float p, out float e)
+{
+    precise float pp = a * b;
+    precise float ca = 4097.0 * a;
+    precise float ahi = ca - (ca - a);
+    precise float alo = a - ahi;
+    precise float cb = 4097.0 * b;
+    precise float bhi = cb - (cb - b);
+    precise float blo = b - bhi;
+    precise float ee = ((ahi * bhi - pp) + ahi * blo + alo * bhi) + alo * blo;
+    p = pp;
+    e = ee;
+}
+
+#define REMAINDER float
+float remainder_of(float a, float b, float q)
+{
+    float p, e;
+    two_prod(q, b, p, e);
+    precise float r = (a - p) - e;
+    return abs(r);
+}
+#endif
+
+float div_rn(float a, float b)
+{
+    precise float q = a / b;
+    if (!(abs(q) >= 1.17549435e-38) || isinf(q)) return q;
+    uint u = floatBitsToUint(q);
+    int step_ = 0;
+    for (int i = 0; i < 4; ++i) {
+        /* bits u - 1 and u + 1 are the neighbours of smaller and larger magnitude */
+        float lo = uintBitsToFloat(u - 1u), hi = uintBitsToFloat(u + 1u);
+        float here = uintBitsToFloat(u);
+        REMAINDER rq = remainder_of(a, b, here);
+        if (step_ <= 0 && remainder_of(a, b, lo) < rq) {
+            u -= 1u;
+            step_ = -1;
+        } else if (step_ >= 0 && remainder_of(a, b, hi) < rq) {
+            u += 1u;
+            step_ = 1;
+        } else {
+            break;
+        }
+    }
+    return uintBitsToFloat(u);
+}
+
 /* ---- rays ----------------------------------------------------------------- */
 
 struct Ray {
@@ -167,9 +235,9 @@ Ray make_ray(vec3 org, vec3 dir)
     r.ox = org[r.kx];
     r.oy = org[r.ky];
     r.oz = org[r.kz];
-    r.sx = dir[r.kx] / dir[kz];
-    r.sy = dir[r.ky] / dir[kz];
-    r.sz = 1.0 / dir[kz];
+    r.sx = div_rn(dir[r.kx], dir[kz]);
+    r.sy = div_rn(dir[r.ky], dir[kz]);
+    r.sz = div_rn(1.0, dir[kz]);
     return r;
 }
 
@@ -179,7 +247,8 @@ Slab make_slab(Ray r)
     s.org = r.org;
     s.zero = equal(r.dir, vec3(0.0));
     /* 1/0 is never evaluated: parallel axes are decided by the inside test */
-    s.inv = vec3(1.0) / mix(r.dir, vec3(1.0), s.zero);
+    vec3 d = mix(r.dir, vec3(1.0), s.zero);
+    s.inv = vec3(div_rn(1.0, d.x), div_rn(1.0, d.y), div_rn(1.0, d.z));
     /* CPU: the entry plane is bmax where 1/dir < 0, including dir = -0.0 */
     s.neg = lessThan(r.dir, vec3(0.0));
     s.any_zero = any(s.zero);
@@ -232,21 +301,6 @@ void edges_exact(float Ax, float Ay, float Bx, float By, float Cx, float Cy, out
 }
 
 #else
-/* a * b = p + e exactly (Dekker's product with Veltkamp's split; no FMA). */
-void two_prod(float a, float b, out float p, out float e)
-{
-    precise float pp = a * b;
-    precise float ca = 4097.0 * a;
-    precise float ahi = ca - (ca - a);
-    precise float alo = a - ahi;
-    precise float cb = 4097.0 * b;
-    precise float bhi = cb - (cb - b);
-    precise float blo = b - bhi;
-    precise float ee = ((ahi * bhi - pp) + ahi * blo + alo * bhi) + alo * blo;
-    p = pp;
-    e = ee;
-}
-
 /* a*b - c*d in float-float, rounded once more to float: the sign is exact
  * (outside contrived cancellations) and f(c, d, a, b) == -f(a, b, c, d)
  * exactly, which is what watertightness needs. */
@@ -307,7 +361,7 @@ bool tri_plane_t(Ray r, vec3 a, vec3 b, vec3 c, inout float t)
     precise float w = nx * (a.x - r.org.x) + ny * (a.y - r.org.y) + nz * (a.z - r.org.z);
     precise float dn = nx * r.dir.x + ny * r.dir.y + nz * r.dir.z;
     if (dn == 0.0) return false;
-    precise float td = w / dn;
+    precise float td = div_rn(w, dn);
     if (!(td > 0.0) || !(td < 3.0e38)) return false;
     t = td;
     return true;
@@ -349,7 +403,7 @@ bool tri_intersect(Ray r, vec3 a, vec3 b, vec3 c, out float t)
     precise float det = U + V + W;
     if (det == 0.0) return false;
     precise float T = U * (r.sz * az) + V * (r.sz * bz) + W * (r.sz * cz);
-    float tt = T / det;
+    float tt = div_rn(T, det);
     if (!(tt > 0.0)) return false;
     /* t tiny against the triangle's extent along the ray: the origin lies
      * (nearly) in its plane, where rounding can fake a small positive t;
@@ -587,7 +641,7 @@ vec3 unit(double x, double y, double z)
 vec3 unit(float x, float y, float z)
 {
     precise float n = sqrt(x * x + y * y + z * z);
-    return vec3(x / n, y / n, z / n);
+    return vec3(div_rn(x, n), div_rn(y, n), div_rn(z, n));
 }
 #endif
 
@@ -659,7 +713,7 @@ vec3 hit_normal(Hit h)
     if (len > 0.0lf) n = vec3(float(double(n.x) / len), float(double(n.y) / len), float(double(n.z) / len));
 #else
     precise float len = sqrt(n.x * n.x + n.y * n.y + n.z * n.z);
-    if (len > 0.0) n = vec3(n.x / len, n.y / len, n.z / len);
+    if (len > 0.0) n = vec3(div_rn(n.x, len), div_rn(n.y, len), div_rn(n.z, len));
 #endif
     return n;
 }
@@ -753,7 +807,7 @@ float refine_t(Hit h, vec3 org, vec3 dir)
     precise float w = nx * (a.x - o.x) + ny * (a.y - o.y) + nz * (a.z - o.z);
     precise float dn = nx * d.x + ny * d.y + nz * d.z;
     if (dn == 0.0) return h.t;
-    precise float td = w / dn;
+    precise float td = div_rn(w, dn);
     /* a sliver's float normal is poor: there the traversal's t is kept */
     return td > 0.0 && td < 3.0e38 && abs(td - h.t) <= 1e-5 * td ? td : h.t;
 }
@@ -810,7 +864,7 @@ bool apply_noise(uvec2 k3, vec3 o, inout float range, inout vec3 pt)
     precise float moved = r + pc.noise_mean + spread;
     moved = clamp(moved, pc.range_min, pc.range_max);
     range = moved;
-    if (r > 0.0) pt = o + (pt - o) * (moved / r);
+    if (r > 0.0) pt = o + (pt - o) * div_rn(moved, r);
 #endif
     return false;
 }
