@@ -248,26 +248,57 @@ static void sections(uint32_t attributes, uint32_t n, uint32_t off[7])
     }
 }
 
-static rc_status copy_out(rc__vk_state *st, const rc__sim_job *job, uint32_t slot, const pending *p)
+/* Copying a slot out is the host's share of a call, and for large batches the
+ * larger share: 10,000 VLP-16 poses are 576 MB of ranges, which one thread
+ * copied at about 8 GB/s out of the H100's host-visible memory, so the copy
+ * and not the GPU set the pace (docs/benchmarks.md). Pieces of 64k elements
+ * go to the context's pool; a slot smaller than that stays on the caller's
+ * thread and wakes nobody. */
+#define RC__VK_COPY_PIECE 65536u
+
+typedef struct copy_run {
+    const rc_results *r;
+    const uint32_t *src;
+    uint32_t off[7];
+    uint32_t attributes;
+    uint32_t n;  /* elements in the slot */
+    uint64_t k;  /* the slot's first element in the caller's arrays */
+} copy_run;
+
+static void copy_task(void *user, uint32_t task, uint32_t thread)
 {
-    const rc_results *r = job->out;
-    const uint32_t *src = (const uint32_t *)st->out[slot].map;
-    const uint32_t n = p->count;
-    const uint64_t k = p->first;
-    uint32_t off[7], i;
-    RC_TRY(rc__vk_buffer_invalidate(st, &st->out[slot]));
-    sections(job->attributes, n, off);
-    if (job->attributes & RC_ATTR_HITS) {
-        const uint32_t *h = src + off[0];
+    const copy_run *c = (const copy_run *)user;
+    const rc_results *r = c->r;
+    const uint32_t *src = c->src;
+    const uint32_t i0 = task * RC__VK_COPY_PIECE;
+    const uint32_t n = c->n - i0 < RC__VK_COPY_PIECE ? c->n - i0 : RC__VK_COPY_PIECE;
+    const uint64_t k = c->k + i0;
+    uint32_t i;
+    (void)thread;
+    if (c->attributes & RC_ATTR_HITS) {
+        const uint32_t *h = src + c->off[0] + i0;
         uint8_t *d = r->hits + k;
         for (i = 0; i < n; ++i) d[i] = (uint8_t)h[i];
     }
-    if (job->attributes & RC_ATTR_RANGES) memcpy(r->ranges + k, src + off[1], (size_t)n * 4u);
-    if (job->attributes & RC_ATTR_POINTS) memcpy(r->points + 3u * k, src + off[2], (size_t)n * 12u);
-    if (job->attributes & RC_ATTR_NORMALS) memcpy(r->normals + 3u * k, src + off[3], (size_t)n * 12u);
-    if (job->attributes & RC_ATTR_PRIM_IDS) memcpy(r->prim_ids + k, src + off[4], (size_t)n * 4u);
-    if (job->attributes & RC_ATTR_GEOM_IDS) memcpy(r->geom_ids + k, src + off[5], (size_t)n * 4u);
-    if (job->attributes & RC_ATTR_INST_IDS) memcpy(r->inst_ids + k, src + off[6], (size_t)n * 4u);
+    if (c->attributes & RC_ATTR_RANGES) memcpy(r->ranges + k, src + c->off[1] + i0, (size_t)n * 4u);
+    if (c->attributes & RC_ATTR_POINTS) memcpy(r->points + 3u * k, src + c->off[2] + 3u * i0, (size_t)n * 12u);
+    if (c->attributes & RC_ATTR_NORMALS) memcpy(r->normals + 3u * k, src + c->off[3] + 3u * i0, (size_t)n * 12u);
+    if (c->attributes & RC_ATTR_PRIM_IDS) memcpy(r->prim_ids + k, src + c->off[4] + i0, (size_t)n * 4u);
+    if (c->attributes & RC_ATTR_GEOM_IDS) memcpy(r->geom_ids + k, src + c->off[5] + i0, (size_t)n * 4u);
+    if (c->attributes & RC_ATTR_INST_IDS) memcpy(r->inst_ids + k, src + c->off[6] + i0, (size_t)n * 4u);
+}
+
+static rc_status copy_out(rc__vk_state *st, const rc__sim_job *job, uint32_t slot, const pending *p)
+{
+    copy_run c;
+    RC_TRY(rc__vk_buffer_invalidate(st, &st->out[slot]));
+    c.r = job->out;
+    c.src = (const uint32_t *)st->out[slot].map;
+    c.attributes = job->attributes;
+    c.n = p->count;
+    c.k = p->first;
+    sections(job->attributes, c.n, c.off);
+    rc__pool_run(st->ctx->pool, (c.n + RC__VK_COPY_PIECE - 1u) / RC__VK_COPY_PIECE, copy_task, &c);
     return RC_OK;
 }
 
