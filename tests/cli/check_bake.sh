@@ -35,6 +35,19 @@ run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2
 grep -Eq '"poses_per_call":1[,}]' out.txt || { cat out.txt; fail "bench reports poses_per_call 1"; }
 cmp ply.f32 one.f32 || fail "one pose a call changed the ranges"
 run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" bench --poses-per-call 0
+# an explicit --poses-per-call is taken as given, past the 128 MiB of ranges
+# that size the default (82 D435 scans): a GPU wants 10,000 VLP-16 scans a call
+run 0 "" "$RC" bench --triangles 1k --pose-count 83 --poses-per-call 83 --repeat 1 --threads 2 --sensor d435 $BACKEND
+grep -Eq '"poses_per_call":83[,}]' out.txt || { cat out.txt; fail "an explicit --poses-per-call is taken as given"; }
+# --results-on-device keeps the timed calls' ranges in Vulkan's device buffer
+run 2 "--results-on-device needs --backend vulkan" "$RC" bench --results-on-device --backend bvh
+if "$RC" help | grep -q "^Backends in this library:[^(]*vulkan"; then
+    run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2 --backend vulkan \
+        --results-on-device --ranges-out device.f32
+    grep -Eq '"results_on_device":true[,}]' out.txt || { cat out.txt; fail "bench reports results_on_device"; }
+    grep -q '"ranges_consistent":true' out.txt || { cat out.txt; fail "results on the device: ranges consistent"; }
+    cmp ply.f32 device.f32 || fail "results on the device changed the ranges"
+fi
 # a short-range sensor on the standard sphere: every ray misses, and bench says why
 run 0 "no ray returned: lds-01 reaches 3.5 m" "$RC" bench --triangles 1k --pose-count 2 --repeat 1 --sensor lds-01 $BACKEND
 grep -Eq '"hit_fraction":0[,}]' out.txt || { cat out.txt; fail "lds-01 on the standard sphere returns nothing"; }

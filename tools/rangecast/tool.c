@@ -52,6 +52,12 @@ int rcp_lib_error(const char *cmd, const rc_context *ctx, const char *call, rc_s
 #define RCP_LOG_TEXT 512
 static void log_to_stderr(void *user, uint32_t level, const char *message)
 {
+    static int info = -1; /* RANGECAST_LOG=info also prints the library's notes (the Vulkan device chosen ...) */
+    if (info < 0) {
+        const char *v = getenv("RANGECAST_LOG");
+        info = v && strcmp(v, "info") == 0;
+    }
+    if (level == RC_LOG_INFO && info) fprintf(stderr, "rangecast: library note: %s\n", message);
     if (level == RC_LOG_WARN) fprintf(stderr, "rangecast: library warning: %s\n", message);
     if (level == RC_LOG_ERROR && user) snprintf((char *)user, RCP_LOG_TEXT, "%s", message);
 }
