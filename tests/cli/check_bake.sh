@@ -47,6 +47,9 @@ if "$RC" help | grep -q "^Backends in this library:[^(]*vulkan"; then
     grep -Eq '"results_on_device":true[,}]' out.txt || { cat out.txt; fail "bench reports results_on_device"; }
     grep -q '"ranges_consistent":true' out.txt || { cat out.txt; fail "results on the device: ranges consistent"; }
     cmp ply.f32 device.f32 || fail "results on the device changed the ranges"
+    # RANGECAST_LOG=info prints the library's notes: the device it chose
+    run 0 "library note: vulkan: " env RANGECAST_LOG=info "$RC" bench --triangles 1k --pose-count 2 --repeat 1 \
+        --backend vulkan
 fi
 # a short-range sensor on the standard sphere: every ray misses, and bench says why
 run 0 "no ray returned: lds-01 reaches 3.5 m" "$RC" bench --triangles 1k --pose-count 2 --repeat 1 --sensor lds-01 $BACKEND
