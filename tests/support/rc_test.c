@@ -20,6 +20,20 @@ int rct_env_on(const char *name)
     return v && v[0] && v[0] != '0';
 }
 
+/* NVIDIA's Vulkan driver can be loaded only about 25 times in one process:
+ * the loader dlopens it at every vkCreateInstance and dlcloses it at
+ * vkDestroyInstance, and glibc does not give back the static TLS the driver
+ * takes (docs/architecture.md, "Vulkan on NVIDIA"). A suite makes contexts
+ * case after case, so the first usable Vulkan context is kept until exit: the
+ * driver stays loaded, as in an application that keeps its context. */
+static rc_context *vulkan_anchor;
+
+static void drop_vulkan_anchor(void)
+{
+    rc_context_destroy(vulkan_anchor);
+    vulkan_anchor = NULL;
+}
+
 int rct_backend_usable(uint32_t backend)
 {
     rc_context_desc d = rc_context_desc_default();
@@ -45,6 +59,10 @@ int rct_backend_usable(uint32_t backend)
         print_message("SKIP: backend %s is built in but not usable here: %s\n", rc_backend_name(backend),
                       rc_status_string(st));
         return 0;
+    }
+    if (backend == RC_BACKEND_VULKAN && !vulkan_anchor && atexit(drop_vulkan_anchor) == 0) {
+        vulkan_anchor = ctx;
+        return 1;
     }
     rc_context_destroy(ctx);
     return 1;
