@@ -240,7 +240,11 @@ RC_API rc_status rc_context_memory_requirements(const rc_context_desc *desc, siz
  * device), RC_ERR_BACKEND. Thread-safe (it touches no shared state). With no
  * context to hold it, a failure's message (naming the desc field, or the
  * backend's own reason, e.g. the Vulkan device that matched nothing) goes to
- * desc->log at RC_LOG_ERROR. */
+ * desc->log at RC_LOG_ERROR. Vulkan on NVIDIA's driver: the loader loads the
+ * driver at each Vulkan context's creation and unloads it at its destruction,
+ * and after about 25 such cycles in one process glibc has no static TLS left
+ * for it (RC_ERR_UNSUPPORTED, "no Vulkan driver"); keep one Vulkan context for
+ * the life of the process rather than creating one per task. */
 RC_API rc_status rc_context_create(const rc_context_desc *desc, rc_context **out);
 
 /* Destroys the context, every scene and sensor created from it, joins the

@@ -250,7 +250,7 @@ static void sections(uint32_t attributes, uint32_t n, uint32_t off[7])
 
 /* Copying a slot out is the host's share of a call, and for large batches the
  * larger share: 10,000 VLP-16 poses are 576 MB of ranges, which one thread
- * copied at about 8 GB/s out of the H100's host-visible memory, so the copy
+ * copied at about 7 GB/s out of the H100's host-visible memory, so the copy
  * and not the GPU set the pace (docs/benchmarks.md). Pieces of 64k elements
  * go to the context's pool; a slot smaller than that stays on the caller's
  * thread and wakes nobody. */
