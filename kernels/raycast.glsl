@@ -73,6 +73,7 @@ layout(push_constant) uniform PC {
 #define NOISE_MOVES 2u
 #define NOISE_DROPS 4u
 #define RC_FLAGS_NEVER_SET 0x80000000u /* RC__VK_FLAGS_NEVER_SET */
+#define RC_FLAGS_SKEW_DIV 0x40000000u  /* RC__VK_FLAGS_SKEW_DIV: tests only */
 
 /* ---- chunked loads ------------------------------------------------------ */
 
@@ -166,6 +167,7 @@ float div_rn(float a, float b)
     precise float q = a / b;
     if (!(abs(q) >= 1.17549435e-38) || isinf(q)) return q;
     uint u = floatBitsToUint(q);
+    if ((pc.flags & RC_FLAGS_SKEW_DIV) != 0u) u += 2u; /* a driver's error, for the tests */
     int step_ = 0;
     for (int i = 0; i < 4; ++i) {
         /* bits u - 1 and u + 1 are the neighbours of smaller and larger magnitude */

@@ -17,7 +17,9 @@
  *   RANGECAST_VULKAN_SLOT_MB      MiB of results one dispatch may write (default 64 on
  *                                 a discrete GPU, else 8)
  *   RANGECAST_VULKAN_RAY_QUERY    1: as RC_CONTEXT_VULKAN_RAY_QUERY (runs a test
- *                                 suite on the ray query traversal unchanged) */
+ *                                 suite on the ray query traversal unchanged)
+ *   RANGECAST_VULKAN_SKEW_DIV     1: the kernel's float divisions start 2 ulps off
+ *                                 (div_rn must put them right; test_stability) */
 #include "backend/vulkan_internal.h"
 
 #include <stdio.h>
@@ -574,6 +576,7 @@ static rc_status device_limits(rc__vk_state *st)
     if (env >= 1024 && env < st->max_binding) st->max_binding = env & ~(uint64_t)15u;
     vkGetPhysicalDeviceFeatures(st->phys, &feats);
     st->fp64 = feats.shaderFloat64 && !env_flag("RANGECAST_VULKAN_NO_FP64");
+    st->skew_div = env_flag("RANGECAST_VULKAN_SKEW_DIV") ? RC__VK_FLAGS_SKEW_DIV : 0u;
 
     RC_RETURN_IF(st->ctx, lim->maxPushConstantsSize < sizeof(rc__vk_push), RC_ERR_UNSUPPORTED,
                  "vulkan: %s has %u bytes of push constants; rangecast needs %u", st->device_name,

@@ -134,6 +134,7 @@ typedef struct rc__vk_state {
     uint64_t heap_size;      /* size of the heap device buffers come from */
     uint32_t subgroup_size;
     uint32_t fp64;           /* shaderFloat64 enabled: the RC_FP64 1 kernel */
+    uint32_t skew_div;       /* RC__VK_FLAGS_SKEW_DIV when RANGECAST_VULKAN_SKEW_DIV=1 (tests) */
     uint32_t ray_query;      /* trace with VK_KHR_ray_query (RC_CONTEXT_VULKAN_RAY_QUERY) */
     uint32_t scratch_align;  /* minAccelerationStructureScratchOffsetAlignment */
     PFN_vkGetBufferDeviceAddress get_address;

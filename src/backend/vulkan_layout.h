@@ -54,6 +54,10 @@ typedef struct rc__vk_push {
  * bit 31 is never set: the kernel ORs it into values it must keep rounded to
  * float (raycast.glsl, f32), a zero the shader compiler cannot fold away. */
 #define RC__VK_FLAGS_NEVER_SET 0x80000000u
+/* bit 30, for tests only (RANGECAST_VULKAN_SKEW_DIV=1): the kernel's float
+ * divisions start 2 ulps off, as a driver's OpFDiv may, so that lavapipe,
+ * which divides exactly, shows whether div_rn puts them right */
+#define RC__VK_FLAGS_SKEW_DIV 0x40000000u
 
 #define RC__VK_NOISE_ON 1u
 #define RC__VK_NOISE_MOVES 2u

@@ -476,7 +476,7 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         push.geom_count = sv->info.geom_count;
         push.top_node = sv->info.top_node;
         push.top_ref = sv->info.top_ref;
-        push.flags = sv->info.flags & ~RC__VK_FLAGS_NEVER_SET;
+        push.flags = (sv->info.flags & ~(RC__VK_FLAGS_NEVER_SET | RC__VK_FLAGS_SKEW_DIV)) | st->skew_div;
         push.groups_x = groups < lim->maxComputeWorkGroupCount[0] ? groups : lim->maxComputeWorkGroupCount[0];
         groups_y = (groups + push.groups_x - 1u) / push.groups_x;
         if (job->noise) noise_push(job, &push);
