@@ -485,6 +485,11 @@ int rcp_cmd_bench(int argc, char **argv)
     if (batch == 0) batch = 1;
     if (batch > a.poses_per_call || a.set_poses_per_call) batch = a.poses_per_call;
     if (batch > pose_count) batch = pose_count;
+    if ((uint64_t)batch * rays > (uint64_t)(SIZE_MAX / sizeof(float))) { /* 32-bit hosts */
+        rcp_fail(cmd, "--poses-per-call %u: %u scans of %u ranges do not fit in this address space", batch, batch,
+                 rays);
+        goto done;
+    }
     ranges = (float *)malloc((size_t)batch * rays * sizeof(float));
     rep_s = (double *)malloc(a.repeat * sizeof(double));
     if (!ranges || !rep_s) {
