@@ -1,8 +1,9 @@
 #!/bin/sh
 # On a machine with a GPU and its Vulkan driver: rangecast bench on the GPU
 # (issue 4's target: VLP-16 on the 1M-triangle sphere, 10,000 poses a call,
-# ranges downloaded to the host), then the test suites on its Vulkan device.
-#   sh tools/device/gpu-run.sh BUNDLE OUTDIR [tests|bench|all]
+# ranges downloaded to the host), the ranges of five sensors against the
+# built-in backend's, then the test suites on its Vulkan device.
+#   sh tools/device/gpu-run.sh BUNDLE OUTDIR [bench|parity|tests|all]
 # BUNDLE is tools/device/bundle.sh's folder. Logs and JSON lines go to OUTDIR;
 # a summary is printed last.
 set -u
@@ -33,6 +34,20 @@ if [ "$what" = bench ] || [ "$what" = all ]; then
 grep -E 'scans_per_s|range_err_p999|hit_mismatch|build_s' | tr '\n' ' ')" | tee -a "$summary"
     done
 fi
+if [ "$what" = parity ] || [ "$what" = all ]; then
+    # the float64 kernel's ranges must be the built-in backend's to the bit
+    # (a driver's inexact division once broke that: architecture.md)
+    for s in vlp16 d435 os1-64 livox-mid40 random-ondn; do
+        for b in bvh vulkan; do
+            "$rc" bench --backend "$b" --triangles 100k --pose-count "${PARITY_POSES:-300}" --repeat 1 --sensor "$s" \
+                --ranges-out "$out/$b.f32" >/dev/null 2>>"$out/bench.err"
+        done
+        echo "ranges $s, bvh against vulkan: $(cmp -l "$out/bvh.f32" "$out/vulkan.f32" 2>&1 | wc -l) bytes differ \
+($(($(wc -c <"$out/bvh.f32") / 4)) rays)" | tee -a "$summary"
+    done
+    rm -f "$out/bvh.f32" "$out/vulkan.f32"
+fi
+
 if [ "$what" = tests ] || [ "$what" = all ]; then
     # every suite that runs a Vulkan context (the CPU backends too: some
     # suites compare against them), into one log
