@@ -121,10 +121,11 @@ vec3 load_vertex(uint i)
 /* ---- correctly rounded float division ------------------------------------ */
 
 /* a / b rounded to nearest, as the CPU divides. A shader's float division may
- * be off by up to 2.5 ulps (Vulkan's bound for OpFDiv; NVIDIA's driver uses
- * it): on an H100 a ray along a box's diagonal got a shear of 0.99999994
- * instead of 1 and slipped past the corner it touches (test_stability,
- * axis_parallel). The rounded quotient is the candidate with the smallest
+ * be off by up to 2.5 ulps (Vulkan's bound for OpFDiv): on an H100 rays along
+ * a box's diagonal slipped past the corner they touch (test_stability,
+ * axis_parallel, 2 of 234), and with this function they no longer do; the
+ * same loss shows on lavapipe when its divisions are skewed by 2 ulps
+ * (RANGECAST_VULKAN_SKEW_DIV). The rounded quotient is the candidate with the smallest
  * remainder |a - q b|, so the driver's quotient is moved an ulp at a time while
  * a neighbour's remainder is smaller. With float64 each remainder is exact (a
  * float product has 48 bits); without it, a - (p + e) from Dekker's exact
