@@ -109,19 +109,6 @@ static void scan(rc_context *ctx, const rc_scene *scene, rct_buffers *b)
     RCT_OK(ctx, rc_sensor_destroy(s));
 }
 
-static void assert_same_bits(const rct_buffers *a, const rct_buffers *b)
-{
-    const uint64_t n = a->n;
-    assert_int_equal(a->n, b->n);
-    assert_memory_equal(a->res.hits, b->res.hits, n);
-    assert_memory_equal(a->res.ranges, b->res.ranges, n * sizeof(float));
-    assert_memory_equal(a->res.points, b->res.points, n * 3u * sizeof(float));
-    assert_memory_equal(a->res.normals, b->res.normals, n * 3u * sizeof(float));
-    assert_memory_equal(a->res.prim_ids, b->res.prim_ids, n * sizeof(uint32_t));
-    assert_memory_equal(a->res.geom_ids, b->res.geom_ids, n * sizeof(uint32_t));
-    assert_memory_equal(a->res.inst_ids, b->res.inst_ids, n * sizeof(uint32_t));
-}
-
 static void test_crc32c_check_value(void **state)
 {
     unsigned char data[1000];
@@ -188,7 +175,7 @@ static void test_load_bit_identical(void **state)
         assert_int_equal(info.committed, 1);
         assert_int_equal(info.triangle_count, (uint64_t)m.room.triangle_count + m.box.triangle_count);
         scan(c, loaded, &got);
-        assert_same_bits(&want, &got);
+        rct_assert_same_results(&want, &got);
         rct_buffers_free(&got);
         rc_context_destroy(c);
         free(arena);
@@ -395,7 +382,7 @@ static void test_get_mesh(void **state)
     RCT_OK(ctx, rc_scene_commit(rebuilt));
     scan(ctx, scene, &want);
     scan(ctx, rebuilt, &got);
-    assert_same_bits(&want, &got);
+    rct_assert_same_results(&want, &got);
     md.struct_size = 8;
     assert_int_equal(rc_baked_get_mesh(m.blob, m.bytes, 0, &md, NULL), RC_ERR_STRUCT_SIZE);
     rct_buffers_free(&want);

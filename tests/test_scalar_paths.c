@@ -7,6 +7,7 @@
 #define rc__mesh_intersect_wide scalar_intersect_wide
 #define rc__mesh_occluded_wide scalar_occluded_wide
 #define rc__mesh_intersect_rays scalar_intersect_rays
+#define rc__mesh_order_key scalar_order_key
 #include "../src/bvh/wide_trace.c"
 #undef rc__mesh_intersect_rays
 #define rc__mesh_intersect_packet scalar_intersect_packet

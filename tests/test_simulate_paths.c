@@ -84,25 +84,9 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
 static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes)
 {
     const rcu_mesh *parts[3];
-    rc_scene_desc sd = rc_scene_desc_default();
-    rc_scene *scene = NULL;
-    uint32_t g, id;
     parts[0] = sphere;
     parts[1] = parts[2] = box;
-    sd.max_geometries = boxes ? 3u : 1u;
-    sd.max_triangles = sphere->triangle_count + (boxes ? 2u * box->triangle_count : 0u);
-    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
-    for (g = 0; g < sd.max_geometries; ++g) {
-        rc_mesh_desc md = rc_mesh_desc_default();
-        md.vertices = parts[g]->vertices;
-        md.vertex_count = parts[g]->vertex_count;
-        md.indices = parts[g]->indices;
-        md.triangle_count = parts[g]->triangle_count;
-        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
-        assert_int_equal(id, g);
-    }
-    RCT_OK(ctx, rc_scene_commit(scene));
-    return scene;
+    return rct_scene_meshes(ctx, parts, boxes ? 3u : 1u);
 }
 
 static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,

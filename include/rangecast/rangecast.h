@@ -835,7 +835,14 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * RC_ERR_INVALID_ARGUMENT; near-unit ones are normalised), a pose that puts
  * the sensor (mounting included) more than 1e9 m from the scene's origin on
  * an axis (RC_ERR_INVALID_ARGUMENT). Runs on the context's
- * threads; results are bit-identical for any thread count. No allocation. */
+ * threads; results are bit-identical for any thread count. No allocation
+ * outside the arena. The built-in backend, on a mesh larger than half the
+ * CPU's last-level cache and a call of many scans, borrows free arena space
+ * while the call runs (16 bytes a tile of 16 rays, at most 4 MiB a thread,
+ * shown in rc_memory_stats.arena_peak) to trace the call's tiles in the order
+ * of the map's tree rather than scan by scan (faster on maps the cache cannot
+ * hold); without that room it runs scan by scan. The results are the same
+ * bits either way. */
 RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
                              const rc_pose *poses, uint32_t pose_count, const rc_results *results);
 

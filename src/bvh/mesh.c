@@ -208,15 +208,20 @@ int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax)
     return rc__traverse(mesh, ray, 0, 0, NULL, tmax, 1);
 }
 
-int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold)
+uint64_t rc__mesh_bytes(const rc__mesh *mesh)
 {
-    const uint64_t bytes = (uint64_t)mesh->wide_count * sizeof(rc__wnode) +
-                           (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
-                           (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
-    return bytes > threshold;
+    return (uint64_t)mesh->wide_count * sizeof(rc__wnode) + (uint64_t)mesh->triangle_count * 4u * sizeof(uint32_t) +
+           (uint64_t)mesh->vertex_count * mesh->stride * sizeof(float);
 }
+
+int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold) { return rc__mesh_bytes(mesh) > threshold; }
 
 uint64_t rc__large_mesh_threshold(uint64_t llc)
 {
     return llc / 8u > RC__LARGE_MESH_BYTES ? llc / 8u : RC__LARGE_MESH_BYTES;
+}
+
+uint64_t rc__ordered_mesh_threshold(uint64_t llc)
+{
+    return llc ? llc / 2u : RC__ORDERED_MESH_BYTES;
 }

@@ -83,9 +83,21 @@ int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax)
 void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
                              rc__hit *hits, int *found);
 
-/* 1 when the mesh's nodes, leaf triangles and vertices take more than
- * threshold bytes: then traversals taking turns pay. */
+/* Bytes of the mesh's nodes, leaf triangles and vertices: what a traversal
+ * reads. */
+uint64_t rc__mesh_bytes(const rc__mesh *mesh);
+/* 1 when rc__mesh_bytes exceeds threshold: then traversals taking turns pay. */
 int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold);
+
+/* An ordering key for the ray: which subtree `depth` levels down the 4-wide
+ * tree (at most RC__ORDER_MAX_DEPTH) its path enters first within (0, tmax),
+ * as node * 4 + child slot (leaves above that depth count as subtrees), or
+ * UINT32_MAX when it enters none. Nodes are depth-first, so work sorted by
+ * key walks the tree's subtrees one after another: rays with the same key
+ * mostly meet the same nodes and triangles, and tracing them back to back
+ * finds those in cache. Only the top of the tree is read. */
+#define RC__ORDER_MAX_DEPTH 12u
+uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax, uint32_t depth);
 
 /* That threshold for a CPU whose last-level cache holds llc bytes (0:
  * unknown): the larger of RC__LARGE_MESH_BYTES and llc / 8. Measured on a
@@ -96,6 +108,14 @@ int rc__mesh_is_large(const rc__mesh *mesh, uint64_t threshold);
  * this is for (2-4 MB), where a 1M map already waits on DRAM. */
 #define RC__LARGE_MESH_BYTES (8u << 20)
 uint64_t rc__large_mesh_threshold(uint64_t llc);
+
+/* Mesh bytes above which the built-in backend orders a call's tiles by
+ * rc__mesh_order_key (backend/bvh.c): half the last-level cache, or
+ * RC__ORDERED_MESH_BYTES when its size is unknown. Measured on a Xeon VM
+ * with a 480 MB L3 (docs/benchmarks.md): +27-34% at 10M triangles (540 MB),
+ * even at 1M (54 MB, in cache), -8% at 100k (in cache, ordered by force). */
+#define RC__ORDERED_MESH_BYTES ((uint64_t)64u << 20)
+uint64_t rc__ordered_mesh_threshold(uint64_t llc);
 
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);

@@ -367,3 +367,52 @@ void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t
         }
     }
 }
+
+/* The ordering key of a ray (mesh.h): the subtree at depth `depth` whose box
+ * the ray enters first, found nearest first through the top of the tree. */
+uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax, uint32_t depth)
+{
+    struct {
+        uint32_t node, depth;
+        float tnear;
+    } stack[3u * RC__ORDER_MAX_DEPTH + 1u];
+    uint32_t sp = 0, key = UINT32_MAX;
+    float best = tmax;
+    wide_ray w;
+    if (!mesh->wide || mesh->wide_count == 0) return UINT32_MAX;
+    if (depth > RC__ORDER_MAX_DEPTH) depth = RC__ORDER_MAX_DEPTH;
+    wide_ray_init(&w, ray);
+    stack[0].node = 0;
+    stack[0].depth = 0;
+    stack[0].tnear = 0.0f;
+    sp = 1;
+    while (sp) {
+        const uint32_t node = stack[sp - 1u].node, d = stack[sp - 1u].depth;
+        const rc__wnode *n = &mesh->wide[node];
+        uint32_t order[4], m = 0, mask, c, i;
+        float tn[4];
+        if (stack[--sp].tnear > best) continue;
+        mask = wide_box_test(n, &w, best, tn);
+        for (c = 0; c < 4; ++c) {
+            if (!((mask >> c) & 1u) || n->child[c] == RC__WIDE_EMPTY || tn[c] > best) continue;
+            if (n->count[c] != 0 || d + 1u >= depth) {
+                if (tn[c] < best || key == UINT32_MAX) {
+                    best = tn[c];
+                    key = node * 4u + c;
+                }
+            } else {
+                /* interior: pushed farthest first, so the nearest pops next */
+                for (i = m; i > 0 && tn[order[i - 1u]] < tn[c]; --i) order[i] = order[i - 1u];
+                order[i] = c;
+                ++m;
+            }
+        }
+        for (i = 0; i < m; ++i) {
+            stack[sp].node = n->child[order[i]];
+            stack[sp].depth = d + 1u;
+            stack[sp].tnear = tn[order[i]];
+            ++sp;
+        }
+    }
+    return key;
+}

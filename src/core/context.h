@@ -32,6 +32,9 @@ struct rc_context {
      * (rc__large_mesh_threshold of the CPU's last-level cache); the Embree
      * backend prefetches its hits' triangles in scenes larger than this. */
     uint64_t large_mesh_bytes;
+    /* The built-in backend orders a call's tiles on meshes larger than this
+     * (rc__ordered_mesh_threshold; UINT64_MAX: never). */
+    uint64_t ordered_mesh_bytes;
     rc_log_fn log;
     void *log_user;
     struct rc_scene *scenes;        /* singly linked, newest first */

@@ -173,6 +173,28 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
     return scene;
 }
 
+rc_scene *rct_scene_meshes(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count)
+{
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_scene *scene = NULL;
+    uint32_t g, id;
+    sd.max_geometries = count;
+    sd.max_triangles = 0;
+    for (g = 0; g < count; ++g) sd.max_triangles += meshes[g]->triangle_count;
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    for (g = 0; g < count; ++g) {
+        rc_mesh_desc md = rc_mesh_desc_default();
+        md.vertices = meshes[g]->vertices;
+        md.vertex_count = meshes[g]->vertex_count;
+        md.indices = meshes[g]->indices;
+        md.triangle_count = meshes[g]->triangle_count;
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+        assert_int_equal(id, g);
+    }
+    RCT_OK(ctx, rc_scene_commit(scene));
+    return scene;
+}
+
 rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax)
 {
     rc_rays_desc d = rc_rays_desc_default();
@@ -325,4 +347,17 @@ void *rct_alloc16(size_t size)
     void *p = NULL;
     if (posix_memalign(&p, 16, size ? size : 16) != 0) return NULL;
     return p;
+}
+
+void rct_assert_same_results(const rct_buffers *a, const rct_buffers *b)
+{
+    const uint64_t n = a->n;
+    assert_int_equal(a->n, b->n);
+    assert_memory_equal(a->res.hits, b->res.hits, n);
+    assert_memory_equal(a->res.ranges, b->res.ranges, n * sizeof(float));
+    assert_memory_equal(a->res.points, b->res.points, n * 3u * sizeof(float));
+    assert_memory_equal(a->res.normals, b->res.normals, n * 3u * sizeof(float));
+    assert_memory_equal(a->res.prim_ids, b->res.prim_ids, n * sizeof(uint32_t));
+    assert_memory_equal(a->res.geom_ids, b->res.geom_ids, n * sizeof(uint32_t));
+    assert_memory_equal(a->res.inst_ids, b->res.inst_ids, n * sizeof(uint32_t));
 }

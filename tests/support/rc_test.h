@@ -33,6 +33,8 @@ rc_context *rct_context(uint32_t backend, uint32_t threads, size_t arena_mb);
 /* A committed scene holding one referenced (or copied) mesh. */
 rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags);
 /* The same, built with build_quality (RC_BUILD_*), not yet committed. */
+/* A committed scene of count referenced meshes; mesh g gets geometry id g. */
+rc_scene *rct_scene_meshes(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count);
 rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags, uint32_t build_quality);
 
 /* rc_context_desc.backend_budget_mib on a backend that allocates outside the
@@ -71,6 +73,8 @@ void rct_buffers_fill(rct_buffers *b, unsigned char pattern);
 /* 1 when every byte of every buffer is still the pattern. */
 int rct_buffers_untouched(const rct_buffers *b, unsigned char pattern);
 void rct_buffers_free(rct_buffers *b);
+/* Every attribute of a and b (the same element count) equal byte for byte. */
+void rct_assert_same_results(const rct_buffers *a, const rct_buffers *b);
 
 /* 16-aligned heap block (posix_memalign) for caller-provided arenas. */
 void *rct_alloc16(size_t size);

@@ -1,0 +1,286 @@
+/* Ordered runs of the built-in backend (backend/bvh.c): on maps larger than
+ * the cache a call's tiles are traced in the order of rc__mesh_order_key,
+ * not scan order. Checked here: the radix sort, the key against a brute-force
+ * search of the tree's top, and that an ordered call writes every attribute
+ * bit for bit as a call in scan order does, on 1, 2 and 3 threads, on one
+ * mesh and on a scene of several, with and without arena room for its
+ * scratch. The context's thresholds are set by the test, whatever this CPU's
+ * cache. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh/intersect.h"
+#include "bvh/mesh.h"
+#include "core/context.h"
+#include "core/radix_sort.h"
+#include "poses.h"
+#include "rc_test.h"
+#include "scene/scene.h"
+
+/* 60 VLP-16 poses (900 tiles each): every chunk holds at least 16,384 tiles
+ * on 1, 2 and 3 threads, so every call below is ordered */
+#define POSES 60u
+
+static rcu_rng rng;
+
+static void test_radix_sort(void **state)
+{
+    const uint32_t n = 5000u;
+    uint32_t *keys = malloc(n * sizeof *keys), *vals = malloc(n * sizeof *vals);
+    uint32_t *tk = malloc(n * sizeof *tk), *tv = malloc(n * sizeof *tv), *seen = calloc(n, sizeof *seen);
+    uint32_t bits, i;
+    (void)state;
+    assert_true(keys && vals && tk && tv && seen);
+    assert_int_equal(rc__bit_width(0u), 0);
+    assert_int_equal(rc__bit_width(1u), 1);
+    assert_int_equal(rc__bit_width(255u), 8);
+    assert_int_equal(rc__bit_width(256u), 9);
+    assert_int_equal(rc__bit_width(UINT32_MAX), 32);
+    /* an even and an odd number of passes, and keys with few distinct values
+     * so that stability shows */
+    for (bits = 7u; bits <= 32u; bits += 25u) {
+        for (i = 0; i < n; ++i) {
+            keys[i] = (uint32_t)(rcu_rng_uniform(&rng) * 4294967295.0) >> (32u - bits);
+            if (i % 3u == 0) keys[i] &= 0x7u;
+            vals[i] = i;
+        }
+        rc__radix_sort_pairs(keys, vals, tk, tv, n, bits);
+        memset(seen, 0, n * sizeof *seen);
+        for (i = 0; i < n; ++i) {
+            assert_true(vals[i] < n);
+            ++seen[vals[i]];
+            if (i > 0) {
+                assert_true(keys[i - 1u] <= keys[i]);
+                if (keys[i - 1u] == keys[i]) assert_true(vals[i - 1u] < vals[i]);
+            }
+        }
+        for (i = 0; i < n; ++i) assert_int_equal(seen[i], 1);
+    }
+    /* no element: nothing read or written */
+    rc__radix_sort_pairs(keys, vals, tk, tv, 0u, 32u);
+    free(keys), free(vals), free(tk), free(tv), free(seen);
+}
+
+/* Entry distance of the ray into box c of node n within [0, tmax], or -1
+ * when it misses (a plain slab test in float, the conservative far bound of
+ * the traversal's). */
+static float box_entry(const rc__wnode *n, uint32_t c, const rc__ray *r, float tmax)
+{
+    float t0 = 0.0f, t1 = tmax;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float a = (n->box[2 * k][c] - r->org[k]) * r->inv_dir[k], b = (n->box[2 * k + 1][c] - r->org[k]) * r->inv_dir[k];
+        if (a > b) {
+            const float s = a;
+            a = b, b = s;
+        }
+        if (a > t0) t0 = a;
+        if (b < t1) t1 = b;
+    }
+    return t0 <= t1 * RC__SLAB_FAR_SCALE ? t0 : -1.0f;
+}
+
+/* The smallest entry distance over every subtree the key can name (a child
+ * at depth `depth`, or a leaf above it) whose box and whose ancestors' boxes
+ * the ray meets. */
+static float brute_first_entry(const rc__mesh *mesh, uint32_t node, uint32_t d, uint32_t depth, const rc__ray *r,
+                               float tmax)
+{
+    const rc__wnode *n = &mesh->wide[node];
+    float best = INFINITY;
+    uint32_t c;
+    for (c = 0; c < 4u; ++c) {
+        float t;
+        if (n->child[c] == RC__WIDE_EMPTY) continue;
+        t = box_entry(n, c, r, tmax);
+        if (t < 0.0f) continue;
+        if (n->count[c] == 0 && d + 1u < depth) t = brute_first_entry(mesh, n->child[c], d + 1u, depth, r, tmax);
+        if (t < best) best = t;
+    }
+    return best;
+}
+
+static void test_order_key(void **state)
+{
+    rcu_mesh sphere;
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 64);
+    rc_scene *scene;
+    const rc__mesh *mesh;
+    uint32_t depth, i, named = 0;
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 120, 60, &sphere), 0);
+    scene = rct_scene_mesh(ctx, &sphere, RC_MESH_REFERENCE);
+    mesh = &scene->geoms[0].mesh;
+    assert_non_null(mesh->wide);
+    for (depth = 1u; depth <= 5u; depth += 2u)
+        for (i = 0; i < 300u; ++i) {
+            float org[3], dir[3], want, got;
+            uint32_t key, k;
+            rc__ray r;
+            for (k = 0; k < 3; ++k) {
+                org[k] = (float)((rcu_rng_uniform(&rng) - 0.5) * 20.0);
+                dir[k] = (float)(rcu_rng_uniform(&rng) - 0.5);
+            }
+            rc__ray_prepare(&r, org, dir);
+            key = rc__mesh_order_key(mesh, &r, 1e6f, depth);
+            want = brute_first_entry(mesh, 0u, 0u, depth, &r, 1e6f);
+            /* from inside the closed sphere every ray enters some subtree */
+            assert_true(isfinite(want));
+            assert_int_not_equal(key, UINT32_MAX);
+            assert_true(key / 4u < mesh->wide_count);
+            got = box_entry(&mesh->wide[key / 4u], key % 4u, &r, 1e6f);
+            assert_true(got >= 0.0f);
+            assert_true(got == want);
+            named += key != 0u;
+        }
+    /* a ray that leaves before any box: no key */
+    {
+        const float org[3] = {100.0f, 0.0f, 0.0f}, dir[3] = {1.0f, 0.0f, 0.0f};
+        rc__ray r;
+        rc__ray_prepare(&r, org, dir);
+        assert_int_equal(rc__mesh_order_key(mesh, &r, 1e6f, 3u), UINT32_MAX);
+    }
+    assert_true(named > 0u);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+}
+
+/* A scene of the sphere and, with box set, a box inside it (geometry 0, so
+ * that the key's mesh is not the first). */
+static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box)
+{
+    const rcu_mesh *parts[2];
+    parts[0] = box ? box : sphere;
+    parts[1] = sphere;
+    return rct_scene_meshes(ctx, parts, box ? 2u : 1u);
+}
+
+/* Simulates POSES VLP-16 poses into buf; returns the arena bytes the call
+ * borrowed at its peak. */
+static uint64_t simulate_all(rc_context *ctx, const rc_scene *scene, const rc_sensor *vlp, const rc_pose *poses,
+                             rct_buffers *buf)
+{
+    rc_memory_stats before, after;
+    memset(&before, 0, sizeof before);
+    memset(&after, 0, sizeof after);
+    before.struct_size = after.struct_size = sizeof before;
+    ctx->arena.peak = ctx->arena.used; /* so that what the call borrows shows */
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &before));
+    rct_buffers_fill(buf, 0xA5);
+    RCT_OK(ctx, rc_simulate(ctx, scene, vlp, poses, POSES, &buf->res));
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &after));
+    assert_int_equal(after.arena_used, before.arena_used);
+    return after.arena_peak - before.arena_peak;
+}
+
+/* Scan order on 1 thread is the reference; ordered calls on 1..3 threads
+ * must match it and must have borrowed their scratch (the arena's peak rose
+ * by at least 16 bytes a tile of a chunk). */
+static void check_ordered(const rcu_mesh *sphere, const rcu_mesh *box, const rc_pose *poses)
+{
+    const uint64_t n = (uint64_t)POSES * 16u * 900u;
+    rct_buffers want, got;
+    uint32_t threads;
+    rct_buffers_alloc(&want, n, RC_ATTR_ALL);
+    rct_buffers_alloc(&got, n, RC_ATTR_ALL);
+    for (threads = 1; threads <= 3; ++threads) {
+        rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 64);
+        rc_scene *scene;
+        rc_sensor *vlp = NULL;
+        uint64_t borrowed;
+        ctx->large_mesh_bytes = 0;
+        scene = make_scene(ctx, sphere, box);
+        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &vlp));
+        if (threads == 1) {
+            ctx->ordered_mesh_bytes = UINT64_MAX;
+            assert_int_equal(simulate_all(ctx, scene, vlp, poses, &want), 0);
+        }
+        ctx->ordered_mesh_bytes = 0;
+        borrowed = simulate_all(ctx, scene, vlp, poses, &got);
+        assert_true(borrowed >= (uint64_t)threads * 16u * 900u * ((POSES + threads - 1u) / threads));
+        rct_assert_same_results(&want, &got);
+        rc_sensor_destroy(vlp);
+        rc_scene_destroy(scene);
+        rc_context_destroy(ctx);
+    }
+    rct_buffers_free(&want);
+    rct_buffers_free(&got);
+}
+
+static void random_poses(rc_pose *poses)
+{
+    uint32_t p;
+    for (p = 0; p < POSES; ++p) {
+        const double yaw = 6.283185307 * rcu_rng_uniform(&rng), pitch = 1.2 * (rcu_rng_uniform(&rng) - 0.5);
+        poses[p] = rct_pose_ypr((float)((rcu_rng_uniform(&rng) - 0.5) * 12.0), (float)((rcu_rng_uniform(&rng) - 0.5) * 12.0),
+                                (float)((rcu_rng_uniform(&rng) - 0.5) * 8.0), yaw, pitch, 0.3 * pitch);
+    }
+}
+
+static void test_ordered_matches_scan_order(void **state)
+{
+    const float lo[3] = {2.0f, -3.0f, -2.0f}, hi[3] = {6.0f, 3.0f, 2.0f};
+    rc_pose poses[POSES];
+    rcu_mesh sphere, box;
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    random_poses(poses);
+    check_ordered(&sphere, NULL, poses);
+    /* two meshes: the key comes from the larger, the box is searched too */
+    check_ordered(&sphere, &box, poses);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+}
+
+/* An arena with no room for the scratch: the call runs in scan order, with
+ * the same results and nothing borrowed. */
+static void test_ordered_without_room(void **state)
+{
+    const uint64_t n = (uint64_t)POSES * 16u * 900u;
+    rc_pose poses[POSES];
+    rct_buffers want, got;
+    rcu_mesh sphere;
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 2, 64);
+    rc_scene *scene;
+    rc_sensor *vlp = NULL;
+    void *hog;
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &sphere), 0);
+    random_poses(poses);
+    ctx->large_mesh_bytes = 0;
+    scene = make_scene(ctx, &sphere, NULL);
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &vlp));
+    rct_buffers_alloc(&want, n, RC_ATTR_RANGES | RC_ATTR_PRIM_IDS);
+    rct_buffers_alloc(&got, n, RC_ATTR_RANGES | RC_ATTR_PRIM_IDS);
+    /* the arena's free space taken but for a few bytes */
+    hog = rc__arena_alloc(&ctx->arena, rc__arena_largest_free(&ctx->arena) - 64u);
+    assert_non_null(hog);
+    ctx->ordered_mesh_bytes = 0;
+    assert_int_equal(simulate_all(ctx, scene, vlp, poses, &got), 0);
+    ctx->ordered_mesh_bytes = UINT64_MAX;
+    assert_int_equal(simulate_all(ctx, scene, vlp, poses, &want), 0);
+    assert_memory_equal(want.res.ranges, got.res.ranges, n * sizeof(float));
+    assert_memory_equal(want.res.prim_ids, got.res.prim_ids, n * sizeof(uint32_t));
+    rc__arena_free(&ctx->arena, hog);
+    rct_buffers_free(&want);
+    rct_buffers_free(&got);
+    rc_sensor_destroy(vlp);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_radix_sort),
+        cmocka_unit_test(test_order_key),
+        cmocka_unit_test(test_ordered_matches_scan_order),
+        cmocka_unit_test(test_ordered_without_room),
+    };
+    rcu_rng_seed(&rng, 0x9E3779B97F4A7C15ull);
+    return cmocka_run_group_tests_name("ordered runs", tests, NULL, NULL);
+}
