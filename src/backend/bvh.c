@@ -289,7 +289,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
 {
     const rc_scene *scene = job->scene;
-    uint32_t threads = ctx->thread_count, g, chunk, max_chunk;
+    uint32_t threads = ctx->thread_count, g, chunk, max_chunk, tasks;
     uint64_t biggest = 0;
     if (!run->packets || !run->large || job->sensor->origins) return 0;
     for (g = 0; g < scene->geom_count; ++g) {
@@ -301,10 +301,14 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
         }
     }
     if (biggest <= ctx->ordered_mesh_bytes) return 0;
-    chunk = (job->pose_count + threads - 1u) / threads;
+    /* as few chunks as the scratch cap allows, a multiple of the thread
+     * count so that no thread is left with the last one alone */
     max_chunk = RC__ORDER_MAX_RECORDS / run->tiles;
-    if (chunk > max_chunk) chunk = max_chunk;
-    if (chunk == 0 || (uint64_t)chunk * run->tiles < RC__ORDER_MIN_RECORDS) return 0;
+    if (max_chunk == 0) return 0;
+    tasks = (job->pose_count + max_chunk - 1u) / max_chunk;
+    tasks = (tasks + threads - 1u) / threads * threads;
+    chunk = (job->pose_count + tasks - 1u) / tasks;
+    if ((uint64_t)chunk * run->tiles < RC__ORDER_MIN_RECORDS) return 0;
     run->chunk_poses = chunk;
     run->order_depth = 1;
     /* subtrees of about 2,048 triangles: deeper keys cost more than they sort */
