@@ -311,7 +311,8 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     if ((uint64_t)chunk * run->tiles < RC__ORDER_MIN_RECORDS) return 0;
     run->chunk_poses = chunk;
     run->order_depth = 1;
-    /* subtrees of about 2,048 triangles: deeper keys cost more than they sort */
+    /* subtrees of 512 to 2,048 triangles (a key's depth measured even from
+     * about 600 to 10,000 at 10M) */
     while (run->order_depth < RC__ORDER_MAX_DEPTH &&
            ((uint64_t)2048u << (2u * run->order_depth)) < scene->geoms[run->order_mesh].mesh.triangle_count)
         ++run->order_depth;
