@@ -239,10 +239,11 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
  * never changes a result. Scratch per thread: keys and records twice over
  * (the radix sort moves through the second pair), then the chunk's world
  * transforms. */
+static size_t order_worlds_offset(size_t records) { return (records * 4u * sizeof(uint32_t) + 15u) / 16u * 16u; }
+
 static size_t order_scratch_bytes(uint32_t chunk_poses, uint32_t tiles)
 {
-    const size_t records = (size_t)chunk_poses * tiles;
-    return (records * 4u * sizeof(uint32_t) + 15u) / 16u * 16u + (size_t)chunk_poses * sizeof(rc__xformf);
+    return order_worlds_offset((size_t)chunk_poses * tiles) + (size_t)chunk_poses * sizeof(rc__xformf);
 }
 
 static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
@@ -255,7 +256,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     unsigned char *scratch = run->order_scratch + (size_t)thread * run->order_scratch_stride;
     const size_t cap = (size_t)run->chunk_poses * run->tiles;
     uint32_t *keys = (uint32_t *)(void *)scratch, *recs = keys + cap, *tmp_keys = recs + cap, *tmp_recs = tmp_keys + cap;
-    rc__xformf *worlds = (rc__xformf *)(void *)(scratch + (cap * 4u * sizeof(uint32_t) + 15u) / 16u * 16u);
+    rc__xformf *worlds = (rc__xformf *)(void *)(scratch + order_worlds_offset(cap));
     uint32_t pose0 = task * run->chunk_poses, poses = run->chunk_poses, p, t, count, top = 0;
     if (poses > job->pose_count - pose0) poses = job->pose_count - pose0;
     count = poses * run->tiles;
