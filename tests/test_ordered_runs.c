@@ -2,8 +2,8 @@
  * the cache a call's tiles are traced in the order of rc__mesh_order_key,
  * not scan order. Checked here: the radix sort, the key against a brute-force
  * search of the tree's top, and that an ordered call writes every attribute
- * bit for bit as a call in scan order does, on 1, 2 and 3 threads, on one
- * mesh and on a scene of several, with and without arena room for its
+ * bit for bit as a call in scan order does, on 1, 2 and 3 threads, for
+ * packets and for OnDn runs, on one mesh and on a scene of several, with and without arena room for its
  * scratch. The context's thresholds are set by the test, whatever this CPU's
  * cache. */
 #include <math.h>
@@ -157,8 +157,8 @@ static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_m
     return rct_scene_meshes(ctx, parts, box ? 2u : 1u);
 }
 
-/* Simulates POSES VLP-16 poses into buf; returns the arena bytes the call
- * borrowed at its peak. */
+/* Simulates the sensor at POSES poses into buf; returns the arena bytes the
+ * call borrowed at its peak. */
 static uint64_t simulate_all(rc_context *ctx, const rc_scene *scene, const rc_sensor *vlp, const rc_pose *poses,
                              rct_buffers *buf)
 {
@@ -175,10 +175,31 @@ static uint64_t simulate_all(rc_context *ctx, const rc_scene *scene, const rc_se
     return after.arena_peak - before.arena_peak;
 }
 
+/* An OnDn sensor of 14,400 rays (900 runs of 16, as many tiles as a VLP-16
+ * has): origins within 1 m, directions sweeping like a scan, so that runs
+ * are coherent as an Ouster unit's are. */
+static float ondn_dirs[3u * 14400u], ondn_orgs[3u * 14400u];
+static rc_sensor *make_sensor(rc_context *ctx, int ondn)
+{
+    rc_rays_desc d = rc_rays_desc_default();
+    rc_sensor *s = NULL;
+    if (!ondn) {
+        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &s));
+        return s;
+    }
+    d.common.range_min = 0.1f;
+    d.common.range_max = 100.0f;
+    d.directions = ondn_dirs;
+    d.origins = ondn_orgs;
+    d.ray_count = 14400u;
+    RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &s));
+    return s;
+}
+
 /* Scan order on 1 thread is the reference; ordered calls on 1..3 threads
  * must match it and must have borrowed their scratch (the arena's peak rose
  * by at least 16 bytes a tile of a chunk). */
-static void check_ordered(const rcu_mesh *sphere, const rcu_mesh *box, const rc_pose *poses)
+static void check_ordered(const rcu_mesh *sphere, const rcu_mesh *box, const rc_pose *poses, int ondn)
 {
     const uint64_t n = (uint64_t)POSES * 16u * 900u;
     rct_buffers want, got;
@@ -188,20 +209,20 @@ static void check_ordered(const rcu_mesh *sphere, const rcu_mesh *box, const rc_
     for (threads = 1; threads <= 3; ++threads) {
         rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 64);
         rc_scene *scene;
-        rc_sensor *vlp = NULL;
+        rc_sensor *sensor;
         uint64_t borrowed;
         ctx->large_mesh_bytes = 0;
         scene = make_scene(ctx, sphere, box);
-        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &vlp));
+        sensor = make_sensor(ctx, ondn);
         if (threads == 1) {
             ctx->ordered_mesh_bytes = UINT64_MAX;
-            assert_int_equal(simulate_all(ctx, scene, vlp, poses, &want), 0);
+            assert_int_equal(simulate_all(ctx, scene, sensor, poses, &want), 0);
         }
         ctx->ordered_mesh_bytes = 0;
-        borrowed = simulate_all(ctx, scene, vlp, poses, &got);
+        borrowed = simulate_all(ctx, scene, sensor, poses, &got);
         assert_true(borrowed >= (uint64_t)threads * 16u * 900u * ((POSES + threads - 1u) / threads));
         rct_assert_same_results(&want, &got);
-        rc_sensor_destroy(vlp);
+        rc_sensor_destroy(sensor);
         rc_scene_destroy(scene);
         rc_context_destroy(ctx);
     }
@@ -224,13 +245,24 @@ static void test_ordered_matches_scan_order(void **state)
     const float lo[3] = {2.0f, -3.0f, -2.0f}, hi[3] = {6.0f, 3.0f, 2.0f};
     rc_pose poses[POSES];
     rcu_mesh sphere, box;
+    uint32_t i, k;
     (void)state;
     assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &sphere), 0);
     assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
     random_poses(poses);
-    check_ordered(&sphere, NULL, poses);
+    for (i = 0; i < 14400u; ++i) {
+        const double yaw = 6.283185307 * (i % 900u) / 900.0, pitch = 0.5 * ((double)(i / 900u) / 15.0 - 0.5);
+        ondn_dirs[3u * i] = (float)(cos(pitch) * cos(yaw));
+        ondn_dirs[3u * i + 1u] = (float)(cos(pitch) * sin(yaw));
+        ondn_dirs[3u * i + 2u] = (float)sin(pitch);
+        for (k = 0; k < 3u; ++k) ondn_orgs[3u * i + k] = (float)(rcu_rng_uniform(&rng) - 0.5);
+    }
+    /* packets, then OnDn runs (single rays mesh by mesh) */
+    check_ordered(&sphere, NULL, poses, 0);
+    check_ordered(&sphere, NULL, poses, 1);
     /* two meshes: the key comes from the larger, the box is searched too */
-    check_ordered(&sphere, &box, poses);
+    check_ordered(&sphere, &box, poses, 0);
+    check_ordered(&sphere, &box, poses, 1);
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&box);
 }

@@ -6,9 +6,11 @@
  * (mesh by mesh in scenes of up to RC__PACKET_MAX_MESHES meshes and no
  * instances; other scenes go ray by ray through the scene's top-level tree).
  * Work is split into tasks of one pose, or of a slice of a pose's tiles when
- * there are fewer poses than threads can keep busy. Each ray's answer depends
- * only on the ray (the packet changes the order of work, not the result), so
- * the split never changes a bit. */
+ * there are fewer poses than threads can keep busy; on a mesh larger than the
+ * cache, of a chunk of poses whose tiles run in the order of the mesh's tree
+ * (ordered runs, below). Each ray's answer depends only on the ray (the packet
+ * changes the order of work, not the result), so neither the split nor the
+ * order ever changes a bit. */
 #include "backend/backend.h"
 #include "bvh/packet.h"
 #include "core/cache_size.h"
@@ -271,7 +273,11 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
             if (row >= sensor->rows) row = sensor->rows - 1u;
             if (col >= sensor->columns) col = sensor->columns - 1u;
             idx = rc__sensor_traced_ray(sensor, row * sensor->columns + col);
-            rc__rays_prepare_turned(worlds[p].r, worlds[p].t, sensor->directions, &idx, 1u, &ray);
+            if (sensor->origins)
+                world_ray_ondn(&worlds[p], sensor->directions + (size_t)idx * 3u, sensor->origins + (size_t)idx * 3u,
+                               &ray);
+            else
+                rc__rays_prepare_turned(worlds[p].r, worlds[p].t, sensor->directions, &idx, 1u, &ray);
             keys[i] = rc__mesh_order_key(mesh, &ray, sensor->range_max, run->order_depth);
             if (keys[i] == UINT32_MAX) keys[i] = 0; /* enters nothing: any place will do */
             if (keys[i] > top) top = keys[i];
@@ -292,7 +298,8 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     const rc_scene *scene = job->scene;
     uint32_t threads = ctx->thread_count, g, chunk, max_chunk, tasks;
     uint64_t biggest = 0;
-    if (!run->packets || !run->large || job->sensor->origins) return 0;
+    /* packets, or OnDn runs of 16 rays going mesh by mesh: both trace tiles */
+    if ((!run->packets && !run->rays_by_mesh) || !run->large) return 0;
     for (g = 0; g < scene->geom_count; ++g) {
         const rc__mesh *mesh = &scene->geoms[g].mesh;
         const uint64_t bytes = rc__mesh_bytes(mesh);
