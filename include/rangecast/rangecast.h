@@ -214,6 +214,12 @@ typedef struct rc_context_desc {
 
 #define RC_ARENA_ALIGNMENT 16u
 #define RC_DEFAULT_ARENA_SIZE ((size_t)256 << 20)
+/* Most arena bytes an rc_simulate call borrows per thread while it runs
+ * (ordered runs on maps larger than the CPU's cache, rc_simulate): give an
+ * arena thread_count times this much beyond the memory requirements to let
+ * such calls run ordered; without the room they run scan by scan (the same
+ * results, slower on those maps). */
+#define RC_SIMULATE_SCRATCH_PER_THREAD ((size_t)5u << 20)
 /* Hard upper bound on thread_count. */
 #define RC_MAX_THREADS 256u
 
@@ -836,13 +842,13 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * the sensor (mounting included) more than 1e9 m from the scene's origin on
  * an axis (RC_ERR_INVALID_ARGUMENT). Runs on the context's
  * threads; results are bit-identical for any thread count. No allocation
- * outside the arena. The built-in backend, on a mesh larger than half the
- * CPU's last-level cache and a call of many scans, borrows free arena space
- * while the call runs (16 bytes a tile of 16 rays, at most 4 MiB a thread,
- * shown in rc_memory_stats.arena_peak) to trace the call's tiles in the order
- * of the map's tree rather than scan by scan (faster on maps the cache cannot
- * hold); without that room it runs scan by scan. The results are the same
- * bits either way. */
+ * outside the arena. The built-in and Embree backends, on a map larger than
+ * half the CPU's last-level cache and a call of many scans, borrow free arena
+ * space while the call runs (16 bytes a tile, at most
+ * RC_SIMULATE_SCRATCH_PER_THREAD a thread, shown in rc_memory_stats.arena_peak)
+ * to trace the call's tiles in the order of the map rather than scan by scan
+ * (faster on maps the cache cannot hold); without that room they run scan by
+ * scan. The results are the same bits either way. */
 RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
                              const rc_pose *poses, uint32_t pose_count, const rc_results *results);
 

@@ -15,18 +15,12 @@
 #include "bvh/packet.h"
 #include "core/cache_size.h"
 #include "core/radix_sort.h"
+#include "core/work_order.h"
 
 #include <math.h>
-#include <stdlib.h>
 #include <string.h>
 
 #define MIN_TILES_PER_TASK 64u
-/* Ordered runs: tiles a task sorts. Below the minimum a chunk meets each
- * subtree too seldom to gain (10M sphere, VLP-16, 2 threads: 9 poses a
- * chunk -2%, 25 poses +10%, 100 +27%, 250 +34%); the maximum bounds the
- * scratch (16 bytes a tile: 4 MiB a thread). */
-#define RC__ORDER_MIN_RECORDS 16384u
-#define RC__ORDER_MAX_RECORDS 262144u
 /* Most meshes a scene may have for packets to test each one per tile: with
  * more, the per-mesh root tests cost more than the packets save (a 100k VLP-16
  * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
@@ -241,13 +235,6 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
  * never changes a result. Scratch per thread: keys and records twice over
  * (the radix sort moves through the second pair), then the chunk's world
  * transforms. */
-static size_t order_worlds_offset(size_t records) { return (records * 4u * sizeof(uint32_t) + 15u) / 16u * 16u; }
-
-static size_t order_scratch_bytes(uint32_t chunk_poses, uint32_t tiles)
-{
-    return order_worlds_offset((size_t)chunk_poses * tiles) + (size_t)chunk_poses * sizeof(rc__xformf);
-}
-
 static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
@@ -255,11 +242,15 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     const rc_sensor *sensor = job->sensor;
     const rc__mesh *mesh = &job->scene->geoms[run->order_mesh].mesh;
     const tiling *tl = &run->tl;
-    unsigned char *scratch = run->order_scratch + (size_t)thread * run->order_scratch_stride;
-    const size_t cap = (size_t)run->chunk_poses * run->tiles;
-    uint32_t *keys = (uint32_t *)(void *)scratch, *recs = keys + cap, *tmp_keys = recs + cap, *tmp_recs = tmp_keys + cap;
-    rc__xformf *worlds = (rc__xformf *)(void *)(scratch + order_worlds_offset(cap));
+    rc__order_scratch sc;
+    uint32_t *keys, *recs;
+    rc__xformf *worlds;
     uint32_t pose0 = task * run->chunk_poses, poses = run->chunk_poses, p, t, count, top = 0;
+    rc__order_scratch_split(run->order_scratch + (size_t)thread * run->order_scratch_stride, run->chunk_poses,
+                            run->tiles, &sc);
+    keys = sc.keys;
+    recs = sc.records;
+    worlds = (rc__xformf *)sc.worlds;
     if (poses > job->pose_count - pose0) poses = job->pose_count - pose0;
     count = poses * run->tiles;
     for (p = 0; p < poses; ++p) {
@@ -284,7 +275,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
             recs[i] = i;
         }
     }
-    rc__radix_sort_pairs(keys, recs, tmp_keys, tmp_recs, count, rc__bit_width(top));
+    rc__radix_sort_pairs(keys, recs, sc.tmp_keys, sc.tmp_records, count, rc__bit_width(top));
     trace_tiles(run, recs, count, pose0, worlds);
 }
 
@@ -296,7 +287,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
 {
     const rc_scene *scene = job->scene;
-    uint32_t threads = ctx->thread_count, g, chunk, max_chunk, tasks;
+    uint32_t threads = ctx->thread_count, g, chunk;
     uint64_t biggest = 0;
     /* packets, or OnDn runs of 16 rays going mesh by mesh: both trace tiles */
     if ((!run->packets && !run->rays_by_mesh) || !run->large) return 0;
@@ -309,14 +300,8 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
         }
     }
     if (biggest <= ctx->ordered_mesh_bytes) return 0;
-    /* as few chunks as the scratch cap allows, a multiple of the thread
-     * count so that no thread is left with the last one alone */
-    max_chunk = RC__ORDER_MAX_RECORDS / run->tiles;
-    if (max_chunk == 0) return 0;
-    tasks = (job->pose_count + max_chunk - 1u) / max_chunk;
-    tasks = (tasks + threads - 1u) / threads * threads;
-    chunk = (job->pose_count + tasks - 1u) / tasks;
-    if ((uint64_t)chunk * run->tiles < RC__ORDER_MIN_RECORDS) return 0;
+    chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles);
+    if (chunk == 0) return 0;
     run->chunk_poses = chunk;
     run->order_depth = 1;
     /* subtrees of 512 to 2,048 triangles (a key's depth measured even from
@@ -324,7 +309,7 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     while (run->order_depth < RC__ORDER_MAX_DEPTH &&
            ((uint64_t)2048u << (2u * run->order_depth)) < scene->geoms[run->order_mesh].mesh.triangle_count)
         ++run->order_depth;
-    run->order_scratch_stride = order_scratch_bytes(chunk, run->tiles);
+    run->order_scratch_stride = rc__order_scratch_bytes(chunk, run->tiles, sizeof(rc__xformf));
     run->order_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->order_scratch_stride * threads);
     return run->order_scratch != NULL;
 }
@@ -381,14 +366,9 @@ static size_t bvh_context_bytes(const rc_context_desc *desc)
 static rc_status bvh_init(rc_context *ctx, const rc_context_desc *desc)
 {
     (void)desc;
-    const char *order = getenv("RANGECAST_BVH_ORDER");
     const uint64_t llc = rc__last_level_cache_bytes();
     ctx->large_mesh_bytes = rc__large_mesh_threshold(llc);
     ctx->ordered_mesh_bytes = rc__ordered_mesh_threshold(llc);
-    /* for tests and measurements: "always" orders every large mesh's calls
-     * (those whose packets take turns), "never" none */
-    if (order && strcmp(order, "always") == 0) ctx->ordered_mesh_bytes = 0;
-    if (order && strcmp(order, "never") == 0) ctx->ordered_mesh_bytes = UINT64_MAX;
     return RC_OK;
 }
 static void bvh_deinit(rc_context *ctx) { (void)ctx; }

@@ -237,6 +237,7 @@ static rc_status emb_init(rc_context *ctx, const rc_context_desc *desc)
     }
     d->native_width = native_width(d->device);
     ctx->large_mesh_bytes = rc__large_mesh_threshold(rc__last_level_cache_bytes());
+    ctx->ordered_mesh_bytes = rc__ordered_mesh_threshold(rc__last_level_cache_bytes());
     ctx->backend_data = d;
     return RC_OK;
 }

@@ -11,6 +11,7 @@
 
 #include "backend/backend.h"
 #include "backend/embree_internal.h"
+#include "scene/occupancy.h"
 
 #if defined(RANGECAST_EMBREE_MAJOR) && RANGECAST_EMBREE_MAJOR >= 4
 #include <embree4/rtcore.h>
@@ -110,7 +111,14 @@ typedef struct rc__emb_scene {
     uint32_t *twin_slots;
     uint32_t twin_mask;
     uint32_t reserved0;
+    /* The own meshes' occupancy (scene/occupancy.h) that keys ordered runs,
+     * on large scenes without instances; NULL elsewhere. Malloc'd, counted
+     * against the budget. */
+    rc__occupancy *occupancy;
 } rc__emb_scene;
+
+/* embree_scene.c: bytes of the scene's own meshes' index and vertex arrays. */
+uint64_t rc__emb_mesh_array_bytes(const rc_scene *scene);
 
 /* The scene holding es's own meshes, which is what instancing es instances. */
 static inline RTCScene rc__emb_mesh_scene(const rc__emb_scene *es)

@@ -500,6 +500,46 @@ static rc_status mesh_instance_set(rc__emb_device *d, rc__emb_scene *es, int mes
     return rc__emb_check(d, "rc_scene_commit (mesh instance)");
 }
 
+/* Bytes of the meshes' own index and vertex arrays (what the refinement
+ * reads beside Embree's structures). */
+uint64_t rc__emb_mesh_array_bytes(const rc_scene *scene)
+{
+    uint64_t bytes = 0;
+    uint32_t g;
+    for (g = 0; g < scene->geom_count; ++g) {
+        const rc__mesh *m = &scene->geoms[g].mesh;
+        bytes += (uint64_t)m->triangle_count * 3u * sizeof(uint32_t) + (uint64_t)m->vertex_count * m->stride * sizeof(float);
+    }
+    return bytes;
+}
+
+/* The occupancy grid of a scene large enough for ordered runs (and without
+ * instances, which it does not see): made at its first such commit, made
+ * again when the triangle count or the bounds change. A mesh moved within
+ * the bounds leaves it stale, which only costs order (so a commit after
+ * updating a small mesh stays cheap). No grid where the budget has no room
+ * for it: the calls then run scan by scan. */
+static void update_occupancy(rc__emb_device *d, rc__emb_scene *es, const rc_scene *scene)
+{
+    rc__occupancy *g = es->occupancy;
+    const uint64_t budget = d->options.budget_bytes;
+    if (scene->inst_count != 0 || scene->geom_count == 0 ||
+        d->options.bytes_now + rc__emb_mesh_array_bytes(scene) <= scene->ctx->large_mesh_bytes)
+        return;
+    if (!g) {
+        if (budget != 0 && d->options.bytes_now + sizeof *g > budget) return;
+        g = (rc__occupancy *)malloc(sizeof *g);
+        if (!g || rc__emb_account(d, (int64_t)sizeof *g, "rc_scene_commit (occupancy grid)") != RC_OK) {
+            free(g);
+            return;
+        }
+        es->occupancy = g;
+    } else if (g->triangles == scene->triangle_count && memcmp(g->bounds, &scene->bounds, sizeof g->bounds) == 0) {
+        return;
+    }
+    rc__occupancy_build(g, scene);
+}
+
 rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *user)
 {
     rc__emb_device *d = (rc__emb_device *)scene->ctx->backend_data;
@@ -565,6 +605,7 @@ rc_status rc__emb_scene_commit(rc_scene *scene, rc_progress_fn progress, void *u
     scene->bounds.max[0] = b.upper_x;
     scene->bounds.max[1] = b.upper_y;
     scene->bounds.max[2] = b.upper_z;
+    update_occupancy(d, es, scene);
     for (i = 0; i < scene->geom_count; ++i) scene->geoms[i].dirty = 0;
     scene->top_dirty = 0;
     es->unfinished = 0;
@@ -587,6 +628,10 @@ void rc__emb_scene_release(rc_scene *scene)
         free_dups(d, &es->geoms[i]);
     }
     rtcReleaseScene(es->scene);
+    if (es->occupancy) {
+        free(es->occupancy);
+        (void)rc__emb_account(d, -(int64_t)sizeof *es->occupancy, "");
+    }
     rc__emb_clear(d);
     rc__arena_free(&scene->ctx->arena, es);
     scene->backend_scene = NULL;

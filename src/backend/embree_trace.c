@@ -38,6 +38,8 @@
  *   context's large_mesh_bytes): on small ones everything is in cache and the
  *   prefetches were 11% more instructions for nothing (1k triangles). */
 #include "backend/embree_impl.h"
+#include "core/radix_sort.h"
+#include "core/work_order.h"
 
 #include <float.h>
 #include <math.h>
@@ -61,6 +63,9 @@ typedef struct trace_run {
     const float *directions;   /* the sensor's tables */
     const float *origins;
     float range_max;
+    uint32_t chunk_poses;      /* ordered runs (core/work_order.h): poses a task */
+    unsigned char *order_scratch; /* ordered runs: order_scratch_stride bytes a thread */
+    size_t order_scratch_stride;
 } trace_run;
 
 /* Ray indices of the lanes of a tile (rows x columns, row-major); lanes past
@@ -96,17 +101,19 @@ static inline void ray_world(const trace_run *run, const rc__xformf *world, uint
 /* Hits held back until their triangles are in cache (see the top). */
 typedef struct hit_batch {
     uint32_t count;
+    uint32_t pose[BATCH_RAYS];   /* relative to the task's first pose */
     uint32_t ray[BATCH_RAYS];
     uint8_t found[BATCH_RAYS];
     rc__hit hit[BATCH_RAYS];
 } hit_batch;
 
 /* Adds ray r's hit from Embree (prefetching its index triple). */
-static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t r, float tfar, float u, float v,
-                             uint32_t prim, uint32_t geom, uint32_t inst)
+static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, uint32_t r, float tfar, float u,
+                             float v, uint32_t prim, uint32_t geom, uint32_t inst)
 {
     rc__hit *hit = &b->hit[b->count];
     int found = geom != RTC_INVALID_GEOMETRY_ID;
+    b->pose[b->count] = pose;
     b->ray[b->count] = r;
     b->found[b->count] = (uint8_t)found;
     b->count++;
@@ -147,8 +154,9 @@ static void batch_prefetch(const trace_run *run, const hit_batch *b)
         if (b->found[i]) rc__scene_hit_prefetch(run->job->scene, &b->hit[i], 1);
 }
 
-/* Writes the batch's rays. */
-static void batch_write(const trace_run *run, const rc__xformf *world, uint64_t base, hit_batch *b)
+/* Writes the batch's rays: entry i is of pose pose0 + b->pose[i], whose
+ * transform is worlds[b->pose[i]]. */
+static void batch_write(const trace_run *run, const rc__xformf *worlds, uint32_t pose0, hit_batch *b)
 {
     const rc__sim_job *job = run->job;
     uint32_t i;
@@ -156,7 +164,8 @@ static void batch_write(const trace_run *run, const rc__xformf *world, uint64_t 
         uint32_t r = b->ray[i];
         const float *ds = run->directions + (size_t)r * 3u;
         const float *os = run->origins ? run->origins + (size_t)r * 3u : NULL;
-        rc__write_result(job, base + r, ds, os, b->found[i], &b->hit[i], NULL, world);
+        rc__write_result(job, (uint64_t)(pose0 + b->pose[i]) * job->sensor->rays + r, ds, os, b->found[i], &b->hit[i],
+                         NULL, &worlds[b->pose[i]]);
     }
     b->count = 0;
 }
@@ -165,8 +174,8 @@ static void batch_write(const trace_run *run, const rc__xformf *world, uint64_t 
  * loads the valid mask as one vector: it sits right after the packet, whose
  * size is a multiple of its (vector) alignment, so it is aligned too. */
 #define RC__EMB_TILE_FN(NAME, W, RAYHIT, INTERSECT)                                                          \
-    static void NAME(const trace_run *run, const rc__xformf *world, uint32_t tile, rc__rtc_query *q,       \
-                     hit_batch *b)                                                                            \
+    static void NAME(const trace_run *run, const rc__xformf *world, uint32_t pose, uint32_t tile,          \
+                     rc__rtc_query *q, hit_batch *b)                                                          \
     {                                                                                                         \
         struct {                                                                                              \
             struct RAYHIT rh;                                                                                 \
@@ -204,7 +213,7 @@ static void batch_write(const trace_run *run, const rc__xformf *world, uint64_t 
         INTERSECT(q, pk.valid, run->scene, &pk.rh);                                                           \
         for (l = 0; l < (W); ++l)                                                                             \
             if (pk.valid[l])                                                                                  \
-                batch_add(run, b, ray[l], pk.rh.ray.tfar[l], pk.rh.hit.u[l], pk.rh.hit.v[l],                  \
+                batch_add(run, b, pose, ray[l], pk.rh.ray.tfar[l], pk.rh.hit.u[l], pk.rh.hit.v[l],            \
                           pk.rh.hit.primID[l], pk.rh.hit.geomID[l], pk.rh.hit.instID[0][l]);                  \
     }
 
@@ -218,7 +227,8 @@ RC__EMB_TILE_FN(tile8, 8, RTCRayHit8, RC__RTC_INTERSECT8)
 RC__EMB_TILE_FN(tile16, 16, RTCRayHit16, RC__RTC_INTERSECT16)
 
 /* One ray through rtcIntersect1 (packet_width 1). */
-static void tile1(const trace_run *run, const rc__xformf *world, uint32_t tile, rc__rtc_query *q, hit_batch *b)
+static void tile1(const trace_run *run, const rc__xformf *world, uint32_t pose, uint32_t tile, rc__rtc_query *q,
+                  hit_batch *b)
 {
     struct RTCRayHit rh;
     float org[3], dir[3];
@@ -242,42 +252,87 @@ static void tile1(const trace_run *run, const rc__xformf *world, uint32_t tile, 
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     RC__RTC_INTERSECT1(q, run->scene, &rh);
-    batch_add(run, b, r, rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, rh.hit.geomID, rh.hit.instID[0]);
+    batch_add(run, b, pose, r, rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, rh.hit.geomID, rh.hit.instID[0]);
+}
+
+/* Traces tiles given as pose * tiles_per_pose + tile (pose relative to
+ * pose0, whose transforms are worlds[]), in that order, writing hits a batch
+ * behind so that one batch's triangles arrive while the next is traced. */
+static void trace_tiles(const trace_run *run, const uint32_t *recs, uint32_t count, uint32_t pose0,
+                        const rc__xformf *worlds)
+{
+    rc__rtc_query q;
+    hit_batch b[2]; /* one fills while the other's vertices arrive */
+    uint32_t i, cur = 0;
+    rc__rtc_query_init(&q, run->coherent);
+    b[0].count = b[1].count = 0;
+    for (i = 0; i < count; ++i) {
+        const uint32_t pose = recs[i] / run->tiles_per_pose, t = recs[i] % run->tiles_per_pose;
+        switch (run->width) {
+        case 16: tile16(run, &worlds[pose], pose, t, &q, &b[cur]); break;
+        case 8: tile8(run, &worlds[pose], pose, t, &q, &b[cur]); break;
+        case 4: tile4(run, &worlds[pose], pose, t, &q, &b[cur]); break;
+        default: tile1(run, &worlds[pose], pose, t, &q, &b[cur]); break;
+        }
+        if (b[cur].count + run->width > BATCH_RAYS) {
+            batch_prefetch(run, &b[cur]);
+            cur ^= 1u;
+            batch_write(run, worlds, pose0, &b[cur]);
+        }
+    }
+    batch_prefetch(run, &b[cur]);
+    batch_write(run, worlds, pose0, &b[cur ^ 1u]);
+    batch_write(run, worlds, pose0, &b[cur]);
 }
 
 static void trace_task(void *user, uint32_t task, uint32_t thread)
 {
     const trace_run *run = (const trace_run *)user;
-    const rc__sim_job *job = run->job;
     uint32_t pose = task / run->slices;
     uint32_t first = (task % run->slices) * run->tiles_per_slice;
-    uint32_t last = first + run->tiles_per_slice;
-    uint64_t base = (uint64_t)pose * job->sensor->rays;
+    uint32_t last = first + run->tiles_per_slice, t;
     rc__xformf world;
-    rc__rtc_query q;
-    hit_batch b[2]; /* one fills while the other's vertices arrive */
-    uint32_t t, cur = 0;
     (void)thread;
     if (last > run->tiles_per_pose) last = run->tiles_per_pose;
-    rc__job_world_xform(job, pose, &world);
-    rc__rtc_query_init(&q, run->coherent);
-    b[0].count = b[1].count = 0;
-    for (t = first; t < last; ++t) {
-        switch (run->width) {
-        case 16: tile16(run, &world, t, &q, &b[cur]); break;
-        case 8: tile8(run, &world, t, &q, &b[cur]); break;
-        case 4: tile4(run, &world, t, &q, &b[cur]); break;
-        default: tile1(run, &world, t, &q, &b[cur]); break;
-        }
-        if (b[cur].count + run->width > BATCH_RAYS) {
-            batch_prefetch(run, &b[cur]);
-            cur ^= 1u;
-            batch_write(run, &world, base, &b[cur]);
+    rc__job_world_xform(run->job, pose, &world);
+    for (t = first; t < last; t += 256u) {
+        uint32_t recs[256], k, m = last - t < 256u ? last - t : 256u;
+        for (k = 0; k < m; ++k) recs[k] = t + k;
+        trace_tiles(run, recs, m, pose, &world);
+    }
+}
+
+/* Ordered runs (core/work_order.h): a chunk of poses whose tiles are keyed
+ * by the first occupied cell their middle ray reaches and traced in key
+ * order. */
+static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
+{
+    const trace_run *run = (const trace_run *)user;
+    const rc__sim_job *job = run->job;
+    uint32_t pose0 = task * run->chunk_poses, poses = run->chunk_poses, p, t, count;
+    rc__order_scratch sc;
+    rc__xformf *worlds;
+    rc__order_scratch_split(run->order_scratch + (size_t)thread * run->order_scratch_stride, run->chunk_poses,
+                            run->tiles_per_pose, &sc);
+    worlds = (rc__xformf *)sc.worlds;
+    if (poses > job->pose_count - pose0) poses = job->pose_count - pose0;
+    count = poses * run->tiles_per_pose;
+    for (p = 0; p < poses; ++p) {
+        rc__job_world_xform(job, pose0 + p, &worlds[p]);
+        for (t = 0; t < run->tiles_per_pose; ++t) {
+            const uint32_t i = p * run->tiles_per_pose + t;
+            uint32_t ray[16], n = 0;
+            float org[3], dir[3];
+            tile_rays(run, t, ray);
+            while (n < run->width && ray[n] != RC_INVALID_ID) ++n;
+            ray_world(run, &worlds[p], ray[n / 2u], org, dir);
+            sc.keys[i] = rc__occupancy_key(run->es->occupancy, org, dir, run->range_max);
+            if (sc.keys[i] == UINT32_MAX) sc.keys[i] = 0; /* meets nothing: any place will do */
+            sc.records[i] = i;
         }
     }
-    batch_prefetch(run, &b[cur]);
-    batch_write(run, &world, base, &b[cur ^ 1u]);
-    batch_write(run, &world, base, &b[cur]);
+    rc__radix_sort_pairs(sc.keys, sc.records, sc.tmp_keys, sc.tmp_records, count, RC__OCC_KEY_BITS);
+    trace_tiles(run, sc.records, count, pose0, worlds);
 }
 
 static uint32_t pick_width(const rc__emb_device *d)
@@ -354,13 +409,7 @@ static uint64_t context_mesh_bytes(const rc_context *ctx)
 {
     const rc_scene *scene;
     uint64_t bytes = 0;
-    uint32_t g;
-    for (scene = ctx->scenes; scene; scene = scene->next)
-        for (g = 0; g < scene->geom_count; ++g) {
-            const rc__mesh *m = &scene->geoms[g].mesh;
-            bytes += (uint64_t)m->triangle_count * 3u * sizeof(uint32_t) +
-                     (uint64_t)m->vertex_count * m->stride * sizeof(float);
-        }
+    for (scene = ctx->scenes; scene; scene = scene->next) bytes += rc__emb_mesh_array_bytes(scene);
     return bytes;
 }
 
@@ -401,7 +450,23 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
         if (run.slices > run.tiles_per_pose) run.slices = run.tiles_per_pose;
     }
     run.tiles_per_slice = (run.tiles_per_pose + run.slices - 1u) / run.slices;
-    rc__pool_run(ctx->pool, job->pose_count * run.slices, trace_task, &run);
+    /* a map larger than the cache, with an occupancy grid: ordered runs on
+     * scratch borrowed from the arena (without room, scan by scan) */
+    run.chunk_poses = 0;
+    run.order_scratch = NULL;
+    if (run.es->occupancy && job->scene->inst_count == 0 &&
+        d->options.bytes_now + context_mesh_bytes(ctx) > ctx->ordered_mesh_bytes)
+        run.chunk_poses = rc__order_chunk_poses(job->pose_count, threads, run.tiles_per_pose);
+    if (run.chunk_poses) {
+        run.order_scratch_stride = rc__order_scratch_bytes(run.chunk_poses, run.tiles_per_pose, sizeof(rc__xformf));
+        run.order_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run.order_scratch_stride * threads);
+    }
+    if (run.order_scratch) {
+        rc__pool_run(ctx->pool, (job->pose_count + run.chunk_poses - 1u) / run.chunk_poses, trace_ordered_task, &run);
+        rc__arena_free(&ctx->arena, run.order_scratch);
+    } else {
+        rc__pool_run(ctx->pool, job->pose_count * run.slices, trace_task, &run);
+    }
     /* rtcIntersect reports only misuse (e.g. an uncommitted scene), which the
      * checks before this call rule out; report it all the same. */
     return rc__emb_check((rc__emb_device *)ctx->backend_data, "rc_simulate");

@@ -228,6 +228,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
 {
     const char *cmd = "bench";
     int i, r;
+    rcp_order_room = 1; /* calls of many scans: room for ordered runs */
     memset(a, 0, sizeof *a);
     a->sensor_name = "vlp16";
     a->backend = RC_BACKEND_AUTO;

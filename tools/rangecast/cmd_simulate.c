@@ -104,6 +104,7 @@ static int parse_args(int argc, char **argv, sim_args *a)
 {
     const char *cmd = "simulate";
     int i, r;
+    rcp_order_room = 1; /* calls of many scans: room for ordered runs */
     memset(a, 0, sizeof *a);
     a->sensor_name = "vlp16";
     a->noise = rc_noise_desc_default();

@@ -354,6 +354,7 @@ void rcp_world_destroy(rcp_world *world)
 
 const char *rcp_device = NULL;
 uint32_t rcp_context_flags = 0;
+int rcp_order_room = 0;
 
 /* Bytes a sensor of the caller's rays adds to rcp_arena_bytes' figure. */
 static int rays_sensor_bytes(const char *cmd, uint32_t model, const rc_rays_desc *rays, size_t *bytes)
@@ -396,6 +397,12 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
         size_t b = 0;
         if (rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
         w->arena_bytes += b;
+    }
+    if (rcp_order_room && mesh) {
+        long cpus = threads ? (long)threads : sysconf(_SC_NPROCESSORS_ONLN);
+        if (cpus < 1) cpus = 1;
+        if (cpus > (long)RC_MAX_THREADS) cpus = (long)RC_MAX_THREADS;
+        w->arena_bytes += (size_t)cpus * RC_SIMULATE_SCRATCH_PER_THREAD;
     }
     cd.backend = backend;
     cd.device = rcp_device;

@@ -86,6 +86,10 @@ extern const char *rcp_device;
 extern uint32_t rcp_context_flags;
 /* --build-quality of bench: the scene's rc_scene_desc.build_quality (RC_BUILD_*). */
 extern uint32_t rcp_build_quality;
+/* 1 (bench, simulate): the contexts get RC_SIMULATE_SCRATCH_PER_THREAD a
+ * thread beyond the exact requirements, so that calls on maps larger than the
+ * cache run ordered; 0 (info, demo): the exact figure. */
+extern int rcp_order_room;
 
 int rcp_world_create(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
                      const uint32_t *presets, uint32_t preset_count, rcp_world *world);

@@ -1,0 +1,38 @@
+/* A coarse occupancy grid of a scene's meshes: RC__OCC_N cells a side over
+ * the scene's bounds, a bit each, set where some triangle's box touches the
+ * cell. It answers one question cheaply: which occupied cell does a ray reach
+ * first? The Embree backend keys its tiles with that (as the built-in backend
+ * keys them with its own tree, rc__mesh_order_key) to trace a call in the
+ * order of the map rather than scan by scan. Only the order of work depends
+ * on it, never a result, so it may be stale (a moved mesh) without harm. */
+#ifndef RC_SCENE_OCCUPANCY_H
+#define RC_SCENE_OCCUPANCY_H
+
+#include "rangecast/rangecast.h"
+
+#include <stdint.h>
+
+#define RC__OCC_N 64u
+
+typedef struct rc__occupancy {
+    float min[3];        /* the grid's corner */
+    float scale[3];      /* cells a metre, per axis */
+    uint64_t triangles;  /* the scene's triangle count when built */
+    float bounds[6];     /* and its bounds (scene->bounds: min, then max) */
+    uint8_t bits[RC__OCC_N * RC__OCC_N * RC__OCC_N / 8u];
+} rc__occupancy;
+
+/* Marks the cells of every triangle of the scene's own meshes (instances are
+ * not looked at) within the scene's bounds (scene->bounds, set by commit). */
+void rc__occupancy_build(rc__occupancy *grid, const rc_scene *scene);
+
+/* The first occupied cell the ray org + t dir, 0 <= t <= tmax, enters (a 3-D
+ * DDA from where it enters the grid), as the Morton code of its (x, y, z)
+ * (neighbouring cells get nearby keys); UINT32_MAX when it meets none. */
+uint32_t rc__occupancy_key(const rc__occupancy *grid, const float org[3], const float dir[3], float tmax);
+
+/* Bits rc__occupancy_key's codes use (keys other than UINT32_MAX stay below
+ * 1 << RC__OCC_KEY_BITS). */
+#define RC__OCC_KEY_BITS 18u
+
+#endif
