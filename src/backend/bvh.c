@@ -14,7 +14,6 @@
 #include "backend/backend.h"
 #include "bvh/packet.h"
 #include "core/cache_size.h"
-#include "core/radix_sort.h"
 #include "core/work_order.h"
 
 #include <math.h>
@@ -241,11 +240,10 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
     const rc__mesh *mesh = &job->scene->geoms[run->order_mesh].mesh;
-    const tiling *tl = &run->tl;
     rc__order_scratch sc;
     uint32_t *keys, *recs;
     rc__xformf *worlds;
-    uint32_t pose0 = task * run->chunk_poses, poses = run->chunk_poses, p, t, count, top = 0;
+    uint32_t pose0 = task * run->chunk_poses, poses = run->chunk_poses, p, t, count;
     rc__order_scratch_split(run->order_scratch + (size_t)thread * run->order_scratch_stride, run->chunk_poses,
                             run->tiles, &sc);
     keys = sc.keys;
@@ -256,26 +254,18 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     for (p = 0; p < poses; ++p) {
         rc__job_world_xform(job, pose0 + p, &worlds[p]);
         for (t = 0; t < run->tiles; ++t) {
-            /* the tile's centre ray (clamped to the grid at its edges) */
-            uint32_t row = (t / tl->grid_cols) * tl->tile_rows + tl->tile_rows / 2u;
-            uint32_t col = (t % tl->grid_cols) * tl->tile_cols + tl->tile_cols / 2u;
-            uint32_t idx, i = p * run->tiles + t;
-            rc__ray ray;
-            if (row >= sensor->rows) row = sensor->rows - 1u;
-            if (col >= sensor->columns) col = sensor->columns - 1u;
-            idx = rc__sensor_traced_ray(sensor, row * sensor->columns + col);
-            if (sensor->origins)
-                world_ray_ondn(&worlds[p], sensor->directions + (size_t)idx * 3u, sensor->origins + (size_t)idx * 3u,
-                               &ray);
-            else
-                rc__rays_prepare_turned(worlds[p].r, worlds[p].t, sensor->directions, &idx, 1u, &ray);
-            keys[i] = rc__mesh_order_key(mesh, &ray, sensor->range_max, run->order_depth);
-            if (keys[i] == UINT32_MAX) keys[i] = 0; /* enters nothing: any place will do */
-            if (keys[i] > top) top = keys[i];
+            /* the tile's middle ray, as the traversal will turn it */
+            uint32_t idx[RC__PACKET_SIZE], i = p * run->tiles + t, n;
+            rc__ray rays[RC__PACKET_SIZE];
+            rc__hit hits[RC__PACKET_SIZE];
+            int found[RC__PACKET_SIZE];
+            n = tile_rays(run, &worlds[p], t, idx, rays, hits, found);
+            keys[i] = rc__mesh_order_key(mesh, &rays[n / 2u], sensor->range_max, run->order_depth);
             recs[i] = i;
         }
     }
-    rc__radix_sort_pairs(keys, recs, sc.tmp_keys, sc.tmp_records, count, rc__bit_width(top));
+    /* a ray that enters nothing (UINT32_MAX) sorts last: any place will do */
+    rc__radix_sort_pairs(keys, recs, sc.tmp_keys, sc.tmp_records, count, 32u);
     trace_tiles(run, recs, count, pose0, worlds);
 }
 

@@ -11,7 +11,7 @@
 
 #include "backend/backend.h"
 #include "backend/embree_internal.h"
-#include "scene/occupancy.h"
+#include "backend/embree_occupancy.h"
 
 #if defined(RANGECAST_EMBREE_MAJOR) && RANGECAST_EMBREE_MAJOR >= 4
 #include <embree4/rtcore.h>
@@ -111,7 +111,7 @@ typedef struct rc__emb_scene {
     uint32_t *twin_slots;
     uint32_t twin_mask;
     uint32_t reserved0;
-    /* The own meshes' occupancy (scene/occupancy.h) that keys ordered runs,
+    /* The own meshes' occupancy (backend/embree_occupancy.h) that keys ordered runs,
      * on large scenes without instances; NULL elsewhere. Malloc'd, counted
      * against the budget. */
     rc__occupancy *occupancy;

@@ -38,7 +38,6 @@
  *   context's large_mesh_bytes): on small ones everything is in cache and the
  *   prefetches were 11% more instructions for nothing (1k triangles). */
 #include "backend/embree_impl.h"
-#include "core/radix_sort.h"
 #include "core/work_order.h"
 
 #include <float.h>

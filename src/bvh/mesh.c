@@ -7,8 +7,6 @@
 #include "core/common.h"
 
 #include <math.h>
-#include <stdlib.h>
-#include <string.h>
 
 void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3])
 {
@@ -225,10 +223,5 @@ uint64_t rc__large_mesh_threshold(uint64_t llc)
 
 uint64_t rc__ordered_mesh_threshold(uint64_t llc)
 {
-    /* for tests and measurements: "always" orders every large mesh's calls,
-     * "never" none */
-    const char *order = getenv("RANGECAST_BVH_ORDER");
-    if (order && strcmp(order, "always") == 0) return 0;
-    if (order && strcmp(order, "never") == 0) return UINT64_MAX;
     return llc ? llc / 2u : RC__ORDERED_MESH_BYTES;
 }

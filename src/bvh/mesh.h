@@ -112,8 +112,8 @@ uint64_t rc__large_mesh_threshold(uint64_t llc);
 /* Mesh bytes above which the built-in backend orders a call's tiles by
  * rc__mesh_order_key (backend/bvh.c), and the Embree backend by its
  * occupancy grid: half the last-level cache, or RC__ORDERED_MESH_BYTES when
- * its size is unknown; RANGECAST_BVH_ORDER=always|never in the environment
- * gives 0 or UINT64_MAX (for tests and measurements). Measured on a Xeon VM
+ * its size is unknown. (Tests set the context's ordered_mesh_bytes to 0 or
+ * UINT64_MAX to force either way.) Measured on a Xeon VM
  * with a 480 MB L3 (docs/benchmarks.md): +27-34% at 10M triangles (540 MB),
  * even at 1M (54 MB, in cache), -8% at 100k (in cache, ordered by force). */
 #define RC__ORDERED_MESH_BYTES ((uint64_t)64u << 20)

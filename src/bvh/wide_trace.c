@@ -369,7 +369,7 @@ void rc__mesh_intersect_rays(const rc__mesh *mesh, const rc__ray *rays, uint32_t
 }
 
 /* The ordering key of a ray (mesh.h): the subtree at depth `depth` whose box
- * the ray enters first, found nearest first through the top of the tree. */
+ * the ray enters first, searched through the top of the tree only. */
 uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax, uint32_t depth)
 {
     struct {
@@ -389,10 +389,12 @@ uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax
     while (sp) {
         const uint32_t node = stack[sp - 1u].node, d = stack[sp - 1u].depth;
         const rc__wnode *n = &mesh->wide[node];
-        uint32_t order[4], m = 0, mask, c, i;
+        uint32_t mask, c;
         float tn[4];
         if (stack[--sp].tnear > best) continue;
         mask = wide_box_test(n, &w, best, tn);
+        /* children in slot order: the search is over every box the ray
+         * meets above the depth, pruned by the nearest entry so far */
         for (c = 0; c < 4; ++c) {
             if (!((mask >> c) & 1u) || n->child[c] == RC__WIDE_EMPTY || tn[c] > best) continue;
             if (n->count[c] != 0 || d + 1u >= depth) {
@@ -401,17 +403,11 @@ uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax
                     key = node * 4u + c;
                 }
             } else {
-                /* interior: pushed farthest first, so the nearest pops next */
-                for (i = m; i > 0 && tn[order[i - 1u]] < tn[c]; --i) order[i] = order[i - 1u];
-                order[i] = c;
-                ++m;
+                stack[sp].node = n->child[c];
+                stack[sp].depth = d + 1u;
+                stack[sp].tnear = tn[c];
+                ++sp;
             }
-        }
-        for (i = 0; i < m; ++i) {
-            stack[sp].node = n->child[order[i]];
-            stack[sp].depth = d + 1u;
-            stack[sp].tnear = tn[order[i]];
-            ++sp;
         }
     }
     return key;

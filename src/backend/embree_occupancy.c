@@ -1,4 +1,4 @@
-#include "scene/occupancy.h"
+#include "backend/embree_occupancy.h"
 
 #include "scene/scene.h"
 
