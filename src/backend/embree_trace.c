@@ -36,7 +36,13 @@
  *   (1M-triangle sphere, VLP-16: the write took ~40% of the time before).
  *   Only on large scenes (Embree's bytes and the meshes' arrays above the
  *   context's large_mesh_bytes): on small ones everything is in cache and the
- *   prefetches were 11% more instructions for nothing (1k triangles). */
+ *   prefetches were 11% more instructions for nothing (1k triangles).
+ * - On a map larger than half the last-level cache, a call of many scans runs
+ *   ordered (core/work_order.h): chunks of poses whose tiles are keyed by the
+ *   first cell of the scene's occupancy grid (embree_occupancy.h) their middle
+ *   ray reaches and traced in key order, so that tiles of different poses
+ *   meeting the same part of the map run back to back (+79% on the
+ *   10M-triangle sphere). A batch then holds hits of several poses. */
 #include "backend/embree_impl.h"
 #include "core/work_order.h"
 
