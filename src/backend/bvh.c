@@ -176,9 +176,10 @@ static uint32_t tile_rays(const sim_run *run, const rc__xformf *world, uint32_t 
     return n;
 }
 
-/* Tiles given as pose * tiles + tile (pose relative to pose0, whose world
- * transforms are worlds[]), traced run->in_flight at a time. */
-static void trace_tiles(const sim_run *run, const uint32_t *recs, uint32_t count, uint32_t pose0,
+/* count tiles traced run->in_flight at a time: recs[i] = pose * tiles + tile
+ * (pose relative to pose0, whose world transforms are worlds[]), or with
+ * recs NULL (scan order, no division a tile) tiles first + i of pose0. */
+static void trace_tiles(const sim_run *run, const uint32_t *recs, uint32_t first, uint32_t count, uint32_t pose0,
                         const rc__xformf *worlds)
 {
     const rc__sim_job *job = run->job;
@@ -195,8 +196,9 @@ static void trace_tiles(const sim_run *run, const uint32_t *recs, uint32_t count
         uint32_t n[RC__PACKETS_IN_FLIGHT], group = count - at < run->in_flight ? count - at : run->in_flight;
         uint32_t k, i;
         for (k = 0; k < group; ++k) {
-            pose[k] = recs[at + k] / run->tiles;
-            n[k] = tile_rays(run, &worlds[pose[k]], recs[at + k] % run->tiles, idx[k], rays[k], hits[k], found[k]);
+            pose[k] = recs ? recs[at + k] / run->tiles : 0u;
+            n[k] = tile_rays(run, &worlds[pose[k]], recs ? recs[at + k] % run->tiles : first + at + k, idx[k], rays[k],
+                             hits[k], found[k]);
         }
         trace_group(run, job->scene, group, rays, n, hits, found);
         for (k = 0; k < group; ++k) {
@@ -215,16 +217,12 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     const sim_run *run = (const sim_run *)user;
     uint32_t pose = task / run->slices;
     uint32_t first = (task % run->slices) * run->tiles_per_slice;
-    uint32_t last = first + run->tiles_per_slice, tile;
+    uint32_t last = first + run->tiles_per_slice;
     rc__xformf world;
     (void)thread;
     if (last > run->tiles) last = run->tiles;
     rc__job_world_xform(run->job, pose, &world);
-    for (tile = first; tile < last; tile += 64u) {
-        uint32_t recs[64], k, m = last - tile < 64u ? last - tile : 64u;
-        for (k = 0; k < m; ++k) recs[k] = tile + k;
-        trace_tiles(run, recs, m, pose, &world);
-    }
+    trace_tiles(run, NULL, first, last - first, pose, &world);
 }
 
 /* Ordered runs (maps larger than the cache): a task is a chunk of poses whose
@@ -266,7 +264,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     }
     /* a ray that enters nothing (UINT32_MAX) sorts last: any place will do */
     rc__radix_sort_pairs(keys, recs, sc.tmp_keys, sc.tmp_records, count, 32u);
-    trace_tiles(run, recs, count, pose0, worlds);
+    trace_tiles(run, recs, 0u, count, pose0, worlds);
 }
 
 /* Sets up an ordered run when it pays: a mesh larger than the cache, and

@@ -260,10 +260,12 @@ static void tile1(const trace_run *run, const rc__xformf *world, uint32_t pose, 
     batch_add(run, b, pose, r, rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, rh.hit.geomID, rh.hit.instID[0]);
 }
 
-/* Traces tiles given as pose * tiles_per_pose + tile (pose relative to
- * pose0, whose transforms are worlds[]), in that order, writing hits a batch
- * behind so that one batch's triangles arrive while the next is traced. */
-static void trace_tiles(const trace_run *run, const uint32_t *recs, uint32_t count, uint32_t pose0,
+/* Traces count tiles in order, writing hits a batch behind so that one
+ * batch's triangles arrive while the next is traced: recs[i] = pose *
+ * tiles_per_pose + tile (pose relative to pose0, whose transforms are
+ * worlds[]), or with recs NULL (scan order, no division a tile) tiles
+ * first + i of pose0. */
+static void trace_tiles(const trace_run *run, const uint32_t *recs, uint32_t first, uint32_t count, uint32_t pose0,
                         const rc__xformf *worlds)
 {
     rc__rtc_query q;
@@ -272,7 +274,8 @@ static void trace_tiles(const trace_run *run, const uint32_t *recs, uint32_t cou
     rc__rtc_query_init(&q, run->coherent);
     b[0].count = b[1].count = 0;
     for (i = 0; i < count; ++i) {
-        const uint32_t pose = recs[i] / run->tiles_per_pose, t = recs[i] % run->tiles_per_pose;
+        const uint32_t pose = recs ? recs[i] / run->tiles_per_pose : 0u;
+        const uint32_t t = recs ? recs[i] % run->tiles_per_pose : first + i;
         switch (run->width) {
         case 16: tile16(run, &worlds[pose], pose, t, &q, &b[cur]); break;
         case 8: tile8(run, &worlds[pose], pose, t, &q, &b[cur]); break;
@@ -295,16 +298,12 @@ static void trace_task(void *user, uint32_t task, uint32_t thread)
     const trace_run *run = (const trace_run *)user;
     uint32_t pose = task / run->slices;
     uint32_t first = (task % run->slices) * run->tiles_per_slice;
-    uint32_t last = first + run->tiles_per_slice, t;
+    uint32_t last = first + run->tiles_per_slice;
     rc__xformf world;
     (void)thread;
     if (last > run->tiles_per_pose) last = run->tiles_per_pose;
     rc__job_world_xform(run->job, pose, &world);
-    for (t = first; t < last; t += 256u) {
-        uint32_t recs[256], k, m = last - t < 256u ? last - t : 256u;
-        for (k = 0; k < m; ++k) recs[k] = t + k;
-        trace_tiles(run, recs, m, pose, &world);
-    }
+    trace_tiles(run, NULL, first, last - first, pose, &world);
 }
 
 /* Ordered runs (core/work_order.h): a chunk of poses whose tiles are keyed
@@ -337,7 +336,7 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
         }
     }
     rc__radix_sort_pairs(sc.keys, sc.records, sc.tmp_keys, sc.tmp_records, count, RC__OCC_KEY_BITS);
-    trace_tiles(run, sc.records, count, pose0, worlds);
+    trace_tiles(run, sc.records, 0u, count, pose0, worlds);
 }
 
 static uint32_t pick_width(const rc__emb_device *d)
