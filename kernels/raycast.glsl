@@ -74,6 +74,8 @@ layout(push_constant) uniform PC {
 #define NOISE_DROPS 4u
 #define RC_FLAGS_NEVER_SET 0x80000000u /* RC__VK_FLAGS_NEVER_SET */
 #define RC_FLAGS_SKEW_DIV 0x40000000u  /* RC__VK_FLAGS_SKEW_DIV: tests only */
+#define RC_FLAGS_SKIP_WALK 0x20000000u  /* RC__VK_FLAGS_SKIP_WALK: measurements only */
+#define RC_FLAGS_SKIP_REFINE 0x10000000u /* RC__VK_FLAGS_SKIP_REFINE: measurements only */
 
 /* ---- chunked loads ------------------------------------------------------ */
 
@@ -894,13 +896,22 @@ void main()
     h.geom = RC_INVALID_ID;
     h.inst = RC_INVALID_ID;
     h.slot = 0u;
-    bool found = trace_scene(org, dir, h);
+    bool found;
+    if ((pc.flags & RC_FLAGS_SKIP_WALK) == 0u) {
+        found = trace_scene(org, dir, h);
+    } else { /* measurements only: what the rest costs */
+        found = true;
+        h.t = 0.5 * pc.range_max;
+        h.prim = 0u;
+        h.geom = 0u;
+    }
 
     float t = h.t;
+    bool refine = found && (pc.flags & RC_FLAGS_SKIP_REFINE) == 0u;
 #if RC_FP64
-    if (found) t = refine_t(h, pose, ds, os);
+    if (refine) t = refine_t(h, pose, ds, os);
 #else
-    if (found) t = refine_t(h, org, dir);
+    if (refine) t = refine_t(h, org, dir);
 #endif
     bool valid = found && t >= pc.range_min && t <= pc.range_max;
     float range = valid ? t : (found && t < pc.range_min ? uintBitsToFloat(0xFF800000u) : uintBitsToFloat(0x7F800000u));

@@ -374,6 +374,64 @@ static void test_binding_limits(void **state)
     rcu_mesh_free(&small);
 }
 
+/* VLP-16 ranges and hits of one pose inside a sphere, from a context made
+ * with the environment variable name=value (NULL: none). */
+static void sphere_scan(const char *name, const char *value, float *ranges, uint8_t *hits)
+{
+    rc_context *ctx;
+    rc_scene *scene;
+    rc_sensor *sensor;
+    rct_buffers buf;
+    rcu_mesh m;
+    rc_pose pose = rct_pose(1.0f, -2.0f, 0.5f);
+    const uint32_t n = 16u * 360u;
+    if (name) setenv(name, value, 1);
+    ctx = rct_context(RC_BACKEND_VULKAN, 1, 0);
+    if (name) unsetenv(name);
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 64, 32, &m), 0);
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16_360, &sensor));
+    rct_buffers_alloc(&buf, n, RC_ATTR_HITS | RC_ATTR_RANGES);
+    RCT_OK(ctx, rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res));
+    memcpy(ranges, buf.res.ranges, n * sizeof *ranges);
+    memcpy(hits, buf.res.hits, n);
+    rct_buffers_free(&buf);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&m);
+}
+
+/* The measurement switches reach the kernel (tools/device/gpu-run.sh split
+ * reads its stages' costs from them): without the walk every ray takes
+ * triangle slot 0's plane, so ranges leave the sphere; without the float64
+ * refinement hits stay and ranges move by float rounding only. The
+ * statistics switch, which lavapipe cannot honour, changes nothing. */
+static void test_measurement_switches(void **state)
+{
+    enum { N = 16 * 360 };
+    static float full[N], other[N];
+    static uint8_t hits[N], other_hits[N];
+    uint32_t i, moved = 0, off_sphere = 0;
+    (void)state;
+    NEED_VULKAN();
+    sphere_scan(NULL, NULL, full, hits);
+    for (i = 0; i < N; ++i) assert_true(hits[i] == 1 && full[i] > 17.0f && full[i] < 23.0f);
+    sphere_scan("RANGECAST_VULKAN_SKIP", "refine", other, other_hits);
+    for (i = 0; i < N; ++i) {
+        assert_int_equal(other_hits[i], 1);
+        assert_true(fabsf(other[i] - full[i]) <= 1e-5f * full[i]);
+        moved += other[i] != full[i];
+    }
+    print_message("skip refine: %u of %u ranges differ in rounding\n", moved, (unsigned)N);
+    assert_true(moved > 0);
+    sphere_scan("RANGECAST_VULKAN_SKIP", "walk", other, other_hits);
+    for (i = 0; i < N; ++i) off_sphere += !(other_hits[i] == 1 && other[i] > 17.0f && other[i] < 23.0f);
+    print_message("skip walk: %u of %u rays off the sphere\n", off_sphere, (unsigned)N);
+    assert_true(off_sphere > N / 2);
+    sphere_scan("RANGECAST_VULKAN_PIPELINE_STATS", "1", other, other_hits);
+    assert_memory_equal(other, full, sizeof full);
+    assert_memory_equal(other_hits, hits, sizeof hits);
+}
+
 /* A sensor destroyed and another created in its place (same arena address,
  * same ray count, other directions) is never served the old cached rays. */
 static void test_sensor_cache(void **state)
@@ -660,6 +718,7 @@ int main(void)
         cmocka_unit_test(test_packed_arrays),   cmocka_unit_test(test_device_choice),
         cmocka_unit_test(test_memory_accounting), cmocka_unit_test(test_budget),
         cmocka_unit_test(test_binding_limits),
+        cmocka_unit_test(test_measurement_switches),
         cmocka_unit_test(test_sensor_cache),    cmocka_unit_test(test_device_lost),
         cmocka_unit_test(test_no_driver),
         cmocka_unit_test(test_dynamic_commit_rewrites_only_the_top),

@@ -19,7 +19,11 @@
  *   RANGECAST_VULKAN_RAY_QUERY    1: as RC_CONTEXT_VULKAN_RAY_QUERY (runs a test
  *                                 suite on the ray query traversal unchanged)
  *   RANGECAST_VULKAN_SKEW_DIV     1: the kernel's float divisions start 2 ulps off
- *                                 (div_rn must put them right; test_stability) */
+ *                                 (div_rn must put them right; test_stability)
+ *   RANGECAST_VULKAN_PIPELINE_STATS 1: log the driver's statistics of each kernel
+ *                                 (registers, spills; vulkan_stats.c)
+ *   RANGECAST_VULKAN_SKIP         walk or refine: the kernel skips that stage, for
+ *                                 measuring what it costs (wrong results) */
 #include "backend/vulkan_internal.h"
 
 #include <stdio.h>
@@ -576,7 +580,12 @@ static rc_status device_limits(rc__vk_state *st)
     if (env >= 1024 && env < st->max_binding) st->max_binding = env & ~(uint64_t)15u;
     vkGetPhysicalDeviceFeatures(st->phys, &feats);
     st->fp64 = feats.shaderFloat64 && !env_flag("RANGECAST_VULKAN_NO_FP64");
-    st->skew_div = env_flag("RANGECAST_VULKAN_SKEW_DIV") ? RC__VK_FLAGS_SKEW_DIV : 0u;
+    st->debug_flags = env_flag("RANGECAST_VULKAN_SKEW_DIV") ? RC__VK_FLAGS_SKEW_DIV : 0u;
+    {
+        const char *skip = getenv("RANGECAST_VULKAN_SKIP");
+        if (skip && strcmp(skip, "walk") == 0) st->debug_flags |= RC__VK_FLAGS_SKIP_WALK;
+        if (skip && strcmp(skip, "refine") == 0) st->debug_flags |= RC__VK_FLAGS_SKIP_REFINE;
+    }
 
     RC_RETURN_IF(st->ctx, lim->maxPushConstantsSize < sizeof(rc__vk_push), RC_ERR_UNSUPPORTED,
                  "vulkan: %s has %u bytes of push constants; rangecast needs %u", st->device_name,
@@ -664,7 +673,7 @@ typedef struct rq_features {
 /* The device's extension names, through the counting allocator (a list on
  * the stack would be 260 bytes an entry, on a thread whose stack may be
  * small; a fixed-size one could come back VK_INCOMPLETE). */
-static rc_status device_extensions(rc__vk_state *st, VkExtensionProperties **out, uint32_t *count)
+rc_status rc__vk_device_extensions(rc__vk_state *st, VkExtensionProperties **out, uint32_t *count)
 {
     uint32_t n = 0;
     VkResult r = vkEnumerateDeviceExtensionProperties(st->phys, NULL, &n, NULL);
@@ -695,7 +704,7 @@ static rc_status ray_query_support(rc__vk_state *st)
     RC_RETURN_IF(st->ctx, st->props.apiVersion < VK_API_VERSION_1_2, RC_ERR_UNSUPPORTED,
                  "vulkan: RC_CONTEXT_VULKAN_RAY_QUERY needs Vulkan 1.2; %s has %u.%u", st->device_name,
                  (unsigned)VK_VERSION_MAJOR(st->props.apiVersion), (unsigned)VK_VERSION_MINOR(st->props.apiVersion));
-    RC_TRY(device_extensions(st, &ext, &n));
+    RC_TRY(rc__vk_device_extensions(st, &ext, &n));
     for (k = 0; k < sizeof ray_query_extensions / sizeof ray_query_extensions[0]; ++k) {
         int found = 0;
         for (i = 0; i < n && !found; ++i) found = strcmp(ext[i].extensionName, ray_query_extensions[k]) == 0;
@@ -766,6 +775,9 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     VkDeviceCreateInfo dci;
     VkPhysicalDeviceFeatures enable;
     rq_features rq;
+    VkPhysicalDevicePipelineExecutablePropertiesFeaturesKHR pe;
+    const char *names[4];
+    uint32_t name_count = 0;
     VkCommandPoolCreateInfo pci;
     VkCommandBufferAllocateInfo cai;
     VkFenceCreateInfo fi;
@@ -802,6 +814,7 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     RC_TRY(pick_device(st));
     RC_TRY(device_limits(st));
     if (st->want_ray_query) RC_TRY(ray_query_support(st));
+    st->stats = (uint32_t)rc__vk_stats_wanted(st);
 
     memset(&qi, 0, sizeof qi);
     qi.sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO;
@@ -815,6 +828,13 @@ rc_status rc__vk_device_create(rc__vk_state *st)
     dci.queueCreateInfoCount = 1;
     dci.pQueueCreateInfos = &qi;
     dci.pEnabledFeatures = &enable;
+    if (st->stats) {
+        memset(&pe, 0, sizeof pe);
+        pe.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PIPELINE_EXECUTABLE_PROPERTIES_FEATURES_KHR;
+        pe.pipelineExecutableInfo = VK_TRUE;
+        dci.pNext = &pe;
+        names[name_count++] = rc__vk_stats_extension;
+    }
     if (st->want_ray_query) {
         memset(&rq, 0, sizeof rq);
         rq.bda.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES;
@@ -825,10 +845,13 @@ rc_status rc__vk_device_create(rc__vk_state *st)
         rq.accel.pNext = &rq.query;
         rq.query.sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR;
         rq.query.rayQuery = VK_TRUE;
+        rq.query.pNext = (void *)dci.pNext;
         dci.pNext = &rq.bda;
-        dci.enabledExtensionCount = (uint32_t)(sizeof ray_query_extensions / sizeof ray_query_extensions[0]);
-        dci.ppEnabledExtensionNames = ray_query_extensions;
+        for (i = 0; i < sizeof ray_query_extensions / sizeof ray_query_extensions[0]; ++i)
+            names[name_count++] = ray_query_extensions[i];
     }
+    dci.enabledExtensionCount = name_count;
+    dci.ppEnabledExtensionNames = name_count ? names : NULL;
     {
         VkResult r = vkCreateDevice(st->phys, &dci, &st->alloc, &st->device);
         if (r != VK_SUCCESS) {

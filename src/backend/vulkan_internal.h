@@ -114,7 +114,7 @@ typedef struct rc__vk_state {
     rc_context *ctx;
     const char *want_device;  /* rc_context_desc.device, during init only */
     uint32_t want_ray_query;  /* RC_CONTEXT_VULKAN_RAY_QUERY or RANGECAST_VULKAN_RAY_QUERY=1 */
-    uint32_t reserved1;
+    uint32_t stats;           /* RANGECAST_VULKAN_PIPELINE_STATS=1 and the extension: log kernel statistics */
     VkAllocationCallbacks alloc;
     uint64_t host_bytes;     /* bytes the driver holds through our callbacks */
     uint64_t device_bytes;   /* bytes of VkDeviceMemory we hold, all kinds */
@@ -134,7 +134,7 @@ typedef struct rc__vk_state {
     uint64_t heap_size;      /* size of the heap device buffers come from */
     uint32_t subgroup_size;
     uint32_t fp64;           /* shaderFloat64 enabled: the RC_FP64 1 kernel */
-    uint32_t skew_div;       /* RC__VK_FLAGS_SKEW_DIV when RANGECAST_VULKAN_SKEW_DIV=1 (tests) */
+    uint32_t debug_flags;    /* RC__VK_FLAGS_SKEW_DIV (tests), _SKIP_WALK, _SKIP_REFINE (measurements) */
     uint32_t ray_query;      /* trace with VK_KHR_ray_query (RC_CONTEXT_VULKAN_RAY_QUERY) */
     uint32_t scratch_align;  /* minAccelerationStructureScratchOffsetAlignment */
     PFN_vkGetBufferDeviceAddress get_address;
@@ -194,6 +194,14 @@ rc_status rc__vk_fail(rc__vk_state *st, VkResult r, const char *what);
 int rc__vk_loader_ok(void);
 /* Instance, device choice (RANGECAST_VULKAN_DEVICE), queue, limits, memory types. */
 rc_status rc__vk_device_create(rc__vk_state *st);
+/* The chosen device's extensions, in memory from rc__vk_host_alloc (free it). */
+rc_status rc__vk_device_extensions(rc__vk_state *st, VkExtensionProperties **out, uint32_t *count);
+
+/* Pipeline statistics (vulkan_stats.c): the extension's name; whether they
+ * were asked for and the device has it; log one pipeline's. */
+extern const char rc__vk_stats_extension[];
+int rc__vk_stats_wanted(rc__vk_state *st);
+void rc__vk_stats_log(rc__vk_state *st, VkPipeline pipe, uint32_t attributes, uint32_t model);
 void rc__vk_device_destroy(rc__vk_state *st);
 
 /* Creates a buffer of size bytes (storage + transfer usage) in memory of the

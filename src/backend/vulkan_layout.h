@@ -58,6 +58,14 @@ typedef struct rc__vk_push {
  * divisions start 2 ulps off, as a driver's OpFDiv may, so that lavapipe,
  * which divides exactly, shows whether div_rn puts them right */
 #define RC__VK_FLAGS_SKEW_DIV 0x40000000u
+/* bits 29 and 28, for measurements only (RANGECAST_VULKAN_SKIP=walk or
+ * refine): the kernel skips the BVH walk (each ray takes slot 0's triangle
+ * as its hit at half the range) or the float64 refinement of the range, so
+ * that the difference in time is what that stage costs on a GPU no profiler
+ * reads (results are wrong in either mode) */
+#define RC__VK_FLAGS_SKIP_WALK 0x20000000u
+#define RC__VK_FLAGS_SKIP_REFINE 0x10000000u
+#define RC__VK_FLAGS_DEBUG (RC__VK_FLAGS_SKEW_DIV | RC__VK_FLAGS_SKIP_WALK | RC__VK_FLAGS_SKIP_REFINE)
 
 #define RC__VK_NOISE_ON 1u
 #define RC__VK_NOISE_MOVES 2u

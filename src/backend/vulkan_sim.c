@@ -160,8 +160,10 @@ static rc_status get_pipeline(rc__vk_state *st, uint32_t attributes, uint32_t mo
     ci.stage.pName = "main";
     ci.stage.pSpecializationInfo = &spec;
     ci.layout = st->pipe_layout;
+    if (st->stats) ci.flags = VK_PIPELINE_CREATE_CAPTURE_STATISTICS_BIT_KHR;
     RC__VK_TRY(st, vkCreateComputePipelines(st->device, st->cache, 1, &ci, RC__VK_OBJ_ALLOC, &slot->pipe),
                "vkCreateComputePipelines");
+    if (st->stats) rc__vk_stats_log(st, slot->pipe, attributes, model);
     slot->attributes = attributes;
     slot->model = model;
     slot->chunked = chunked;
@@ -476,7 +478,7 @@ static rc_status simulate(rc__vk_state *st, const rc__sim_job *job)
         push.geom_count = sv->info.geom_count;
         push.top_node = sv->info.top_node;
         push.top_ref = sv->info.top_ref;
-        push.flags = (sv->info.flags & ~(RC__VK_FLAGS_NEVER_SET | RC__VK_FLAGS_SKEW_DIV)) | st->skew_div;
+        push.flags = (sv->info.flags & ~(RC__VK_FLAGS_NEVER_SET | RC__VK_FLAGS_DEBUG)) | st->debug_flags;
         push.groups_x = groups < lim->maxComputeWorkGroupCount[0] ? groups : lim->maxComputeWorkGroupCount[0];
         groups_y = (groups + push.groups_x - 1u) / push.groups_x;
         if (job->noise) noise_push(job, &push);

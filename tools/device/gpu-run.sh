@@ -3,9 +3,12 @@
 # (issue 4's target: VLP-16 on the 1M-triangle sphere, 10,000 poses a call,
 # ranges downloaded to the host), the ranges of five sensors against the
 # built-in backend's, then the test suites on its Vulkan device.
-#   sh tools/device/gpu-run.sh BUNDLE OUTDIR [bench|parity|tests|all]
+#   sh tools/device/gpu-run.sh BUNDLE OUTDIR [bench|split|parity|tests|all]
 # BUNDLE is tools/device/bundle.sh's folder. Logs and JSON lines go to OUTDIR;
-# a summary is printed last.
+# a summary is printed last. split (not in all) times the kernel's stages by
+# leaving one out (RANGECAST_VULKAN_SKIP) and the float-only kernel, at 1k and
+# 1M. bench logs the driver's statistics of each kernel (registers, local
+# memory: RANGECAST_VULKAN_PIPELINE_STATS) into bench.err.
 set -u
 bundle=$(cd "$1" && pwd)
 out=$2
@@ -28,11 +31,29 @@ summary=$out/summary.txt
 if [ "$what" = bench ] || [ "$what" = all ]; then
     # issue 4's figure, then the other sizes; stderr (the device note) kept
     for n in 1M 1k 10k 100k 10M; do
-        "$rc" bench --backend vulkan --triangles "$n" --pose-count 10000 --poses-per-call 10000 --repeat 5 \
+        RANGECAST_VULKAN_PIPELINE_STATS=1 "$rc" bench --backend vulkan --triangles "$n" --pose-count 10000 --poses-per-call 10000 --repeat 5 \
             >>"$out/bench.jsonl" 2>>"$out/bench.err"
         echo "bench vulkan $n: exit $?; $(tail -n 1 "$out/bench.jsonl" | tr ',' '\n' | \
 grep -E 'scans_per_s|range_err_p999|hit_mismatch|build_s' | tr '\n' ' ')" | tee -a "$summary"
     done
+fi
+if [ "$what" = split ]; then
+    # where the kernel's time goes: each stage's cost is the full kernel's time
+    # less the time without it (the results of the skipping runs are wrong)
+    for n in 1k 1M; do
+        for mode in full walk refine float-only full; do
+            case $mode in
+                walk|refine) set -- env RANGECAST_VULKAN_SKIP=$mode ;;
+                float-only) set -- env RANGECAST_VULKAN_NO_FP64=1 ;;
+                *) set -- env ;;
+            esac
+            "$@" "$rc" bench --backend vulkan --triangles "$n" --pose-count 10000 --poses-per-call 10000 --repeat 5 \
+                >"$out/one.json" 2>>"$out/bench.err"
+            sed "s/^{/{\"split\":\"$mode\",/" "$out/one.json" >>"$out/split.jsonl"
+            echo "split $n $mode: $(tr ',' '\n' <"$out/one.json" | grep -E '"scans_per_s' | tr '\n' ' ')" | tee -a "$summary"
+        done
+    done
+    rm -f "$out/one.json"
 fi
 if [ "$what" = parity ] || [ "$what" = all ]; then
     # the float64 kernel's ranges must be the built-in backend's to the bit
