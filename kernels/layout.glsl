@@ -13,9 +13,17 @@
  *         interior: count == 0, children nodes[base + index], nodes[base + index + 1]
  *         leaf:     count >= 1, items refs[ref_base + index .. + count)
  *         (std430 puts a vec3 at a 16-byte boundary and the following uint in
- *         its 4th word: exactly the C struct.)
+ *         its 4th word: exactly the C struct.) The top level's nodes.
+ *   WNode (128 bytes = 4 Node slots, 4-aligned) = rc__wnode (src/bvh/wide.h),
+ *         a mesh's 4-wide node, read as 8 uvec4 of the same bindings:
+ *           uvec4 0..5  box planes bmin x, bmax x, bmin y, bmax y, bmin z,
+ *                       bmax z (float bits), one lane per child
+ *           uvec4 6     child: wide node index (relative) or first leaf slot;
+ *                       0xFFFFFFFF for an empty slot
+ *           uvec4 7     count: 0 for a node, else the leaf's triangles (1..4)
  *   Geom  (16 bytes) = rc__vk_geom: where one mesh's arrays start in the
- *         concatenated scene arrays, and its geometry id within its own scene.
+ *         concatenated scene arrays (node_base: its wide root's first slot),
+ *         and its geometry id within its own scene.
  *           off 0 node_base | off 4 ref_base | off 8 tri_base | off 12 geom_id
  *         tris[tri_base + j] (3 uints, vertex indices already offset into
  *         the concatenated vertex array) is the triangle of the mesh's leaf

@@ -37,6 +37,13 @@ layout(std430, binding = 9) readonly buffer Verts1 { float v[]; } verts1;
 layout(std430, binding = 10) readonly buffer Verts2 { float v[]; } verts2;
 layout(std430, binding = 11) readonly buffer Verts3 { float v[]; } verts3;
 #endif
+/* The same node bindings as raw 16-byte words: a mesh's wide nodes (WNode) */
+layout(std430, binding = 0) readonly buffer NodeWords0 { uvec4 q[]; } words0;
+#if RC_CHUNKS > 1
+layout(std430, binding = 1) readonly buffer NodeWords1 { uvec4 q[]; } words1;
+layout(std430, binding = 2) readonly buffer NodeWords2 { uvec4 q[]; } words2;
+layout(std430, binding = 3) readonly buffer NodeWords3 { uvec4 q[]; } words3;
+#endif
 layout(std430, binding = 12) readonly buffer Refs { uint r[]; } refs;
 layout(std430, binding = 13) readonly buffer Geoms { Geom g[]; } geoms;
 layout(std430, binding = 14) readonly buffer Insts { Inst i[]; } insts;
@@ -89,6 +96,20 @@ Node load_node(uint i)
     return nodes3.n[j];
 #else
     return nodes0.n[i];
+#endif
+}
+
+/* Word w of the node arrays (two per Node slot). */
+uvec4 load_word(uint w)
+{
+#if RC_CHUNKS > 1
+    uint c = (w >> 1u) >> NODE_SHIFT, j = w - ((c << NODE_SHIFT) << 1u);
+    if (c == 0u) return words0.q[j];
+    if (c == 1u) return words1.q[j];
+    if (c == 2u) return words2.q[j];
+    return words3.q[j];
+#else
+    return words0.q[w];
 #endif
 }
 
@@ -436,54 +457,141 @@ bool key_less(uint inst, uint geom, uint prim, Hit h)
     return prim < h.prim;
 }
 
-/* rc__mesh_intersect: ordered traversal of one mesh's BVH, written
- * "while-while" (Aila & Laine 2009): an inner loop walks interior nodes only,
- * leaves are tested after it, so lanes of a SIMD group test triangles
- * together (and a masked-execution device such as lavapipe runs each part only
- * while some lane needs it). The nodes visited and the hit kept are those of
- * the C code: nearer child first, farther pushed with its entry distance,
- * popped entries dropped when they start beyond the nearest hit. */
+/* Lanes of a bvec4 as bits 0..3. */
+uint bits4(bvec4 b) { return (b.x ? 1u : 0u) | (b.y ? 2u : 0u) | (b.z ? 4u : 0u) | (b.w ? 8u : 0u); }
+
+/* Entry distances of a wide node's four child boxes (word w0 on), the
+ * node's child and count words, and a mask of the children met within
+ * [0, tmax]: node_hit for four boxes at once, empty slots never met. */
+uint wide_box_test(uint w0, Slab s, float tmax, out vec4 tn, out uvec4 child, out uvec4 count)
+{
+    vec4 xl = uintBitsToFloat(load_word(w0)), xh = uintBitsToFloat(load_word(w0 + 1u));
+    vec4 yl = uintBitsToFloat(load_word(w0 + 2u)), yh = uintBitsToFloat(load_word(w0 + 3u));
+    vec4 zl = uintBitsToFloat(load_word(w0 + 4u)), zh = uintBitsToFloat(load_word(w0 + 5u));
+    child = load_word(w0 + 6u);
+    count = load_word(w0 + 7u);
+    vec4 ax = ((s.neg.x ? xh : xl) - s.org.x) * s.inv.x;
+    vec4 bx = ((s.neg.x ? xl : xh) - s.org.x) * s.inv.x;
+    vec4 ay = ((s.neg.y ? yh : yl) - s.org.y) * s.inv.y;
+    vec4 by = ((s.neg.y ? yl : yh) - s.org.y) * s.inv.y;
+    vec4 az = ((s.neg.z ? zh : zl) - s.org.z) * s.inv.z;
+    vec4 bz = ((s.neg.z ? zl : zh) - s.org.z) * s.inv.z;
+    uint met = bits4(notEqual(child, uvec4(0xFFFFFFFFu)));
+    if (s.any_zero) {
+        /* an axis the ray is parallel to: inside its slab or never */
+        if (s.zero.x) {
+            met &= ~(bits4(lessThan(vec4(s.org.x), xl)) | bits4(greaterThan(vec4(s.org.x), xh)));
+            ax = vec4(0.0);
+            bx = vec4(tmax);
+        }
+        if (s.zero.y) {
+            met &= ~(bits4(lessThan(vec4(s.org.y), yl)) | bits4(greaterThan(vec4(s.org.y), yh)));
+            ay = vec4(0.0);
+            by = vec4(tmax);
+        }
+        if (s.zero.z) {
+            met &= ~(bits4(lessThan(vec4(s.org.z), zl)) | bits4(greaterThan(vec4(s.org.z), zh)));
+            az = vec4(0.0);
+            bz = vec4(tmax);
+        }
+    }
+    tn = max(max(ax, ay), max(az, vec4(0.0)));
+    vec4 tf = min(min(bx, by), min(bz, vec4(tmax)));
+    return met & bits4(lessThanEqual(tn, tf * SLAB_FAR_SCALE));
+}
+
+/* Lane k of a vector by selects (a run-time index could go to local memory). */
+float lane_f(vec4 v, uint k) { return k == 0u ? v.x : (k == 1u ? v.y : (k == 2u ? v.z : v.w)); }
+uint lane_u(uvec4 v, uint k) { return k == 0u ? v.x : (k == 1u ? v.y : (k == 2u ? v.z : v.w)); }
+
+/* Orders (key, lane) pairs by key. */
+void order2(inout float ka, inout uint ia, inout float kb, inout uint ib)
+{
+    if (kb < ka) {
+        float k = ka;
+        ka = kb;
+        kb = k;
+        uint i = ia;
+        ia = ib;
+        ib = i;
+    }
+}
+
+#define WIDE_STACK (3u * MAX_DEPTH + 4u) /* three pushes per level at most */
+
+/* rc__mesh_intersect over the mesh's 4-wide nodes (the CPU's own layout,
+ * src/bvh/wide_trace.c), written "while-while" (Aila & Laine 2009): an inner
+ * loop walks nodes only, a leaf's triangles are tested after it, so lanes of
+ * a SIMD group test triangles together (and a masked-execution device such
+ * as lavapipe runs each part only while some lane needs it). Children met are
+ * visited nearest first, the others pushed with their entry distances,
+ * popped entries dropped when they start beyond the nearest hit by more than
+ * the box test's slack: the hit kept is the C code's whatever the order (the
+ * tie rule decides equal distances). A stack entry is a node (count 0) or a
+ * leaf's run of slots. */
 bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
 {
     Geom g = geoms.g[gi];
-    uint stk_n[MAX_DEPTH];
-    float stk_t[MAX_DEPTH];
-    uint sp = 0u;
-    float tn;
-    bool found = false, alive;
-    Node n = load_node(g.node_base);
-    alive = node_hit(n, s, h.t, tn);
+    uint stk_c[WIDE_STACK];
+    uint stk_n[WIDE_STACK];
+    float stk_t[WIDE_STACK];
+    uint sp = 0u, cur = 0u, cnt = 0u; /* the root node */
+    bool found = false, alive = true;
+    uint wbase = 2u * g.node_base;
     while (alive) {
-        while (alive && n.count == 0u) {
-            uint c = n.index;
-            float t0, t1;
-            Node n0 = load_node(g.node_base + c);
-            Node n1 = load_node(g.node_base + c + 1u);
-            bool h0 = node_hit(n0, s, h.t, t0);
-            bool h1 = node_hit(n1, s, h.t, t1);
-            if (h0 && h1) {
-                bool second = t1 < t0;
-                n = second ? n1 : n0;
-                if (sp < MAX_DEPTH) {
-                    stk_n[sp] = second ? c : c + 1u;
-                    stk_t[sp] = second ? t0 : t1;
-                    ++sp;
-                }
-            } else if (h0 || h1) {
-                n = h0 ? n0 : n1;
-            } else {
-                alive = false;
-                while (sp > 0u && !alive) {
-                    --sp;
-                    if (stk_t[sp] <= h.t * SLAB_FAR_SCALE) { /* the box test's slack: ties are never culled */
-                        n = load_node(g.node_base + stk_n[sp]);
-                        alive = true;
+        while (alive && cnt == 0u) {
+            vec4 tn;
+            uvec4 child, count;
+            uint met = wide_box_test(wbase + 8u * cur, s, h.t, tn, child, count);
+            if (met != 0u && (met & (met - 1u)) == 0u) { /* one child met: no order, no push */
+                uint l = uint(findLSB(met));
+                cur = lane_u(child, l);
+                cnt = lane_u(count, l);
+                continue;
+            }
+            if (met != 0u) {
+                /* children met, nearest first: sort (distance, lane) pairs,
+                 * misses last; push all but the nearest, farthest first */
+                const float far_ = 3.4028235e38;
+                float k0 = (met & 1u) != 0u ? tn.x : far_, k1 = (met & 2u) != 0u ? tn.y : far_;
+                float k2 = (met & 4u) != 0u ? tn.z : far_, k3 = (met & 8u) != 0u ? tn.w : far_;
+                uint i0 = 0u, i1 = 1u, i2 = 2u, i3 = 3u;
+                order2(k0, i0, k1, i1);
+                order2(k2, i2, k3, i3);
+                order2(k0, i0, k2, i2);
+                order2(k1, i1, k3, i3);
+                order2(k1, i1, k2, i2);
+                uint lanes = i0 | (i1 << 2u) | (i2 << 4u) | (i3 << 6u);
+                bool have = false;
+                float held_t = 0.0;
+                for (int p = 3; p >= 0; --p) {
+                    uint l = (lanes >> (2u * uint(p))) & 3u;
+                    if ((met & (1u << l)) == 0u) continue;
+                    if (have && sp < WIDE_STACK) { /* the one held is farther: pushed */
+                        stk_c[sp] = cur;
+                        stk_n[sp] = cnt;
+                        stk_t[sp] = held_t;
+                        ++sp;
                     }
+                    cur = lane_u(child, l);
+                    cnt = lane_u(count, l);
+                    held_t = lane_f(tn, l);
+                    have = true;
+                }
+                continue;
+            }
+            alive = false;
+            while (sp > 0u && !alive) {
+                --sp;
+                if (stk_t[sp] <= h.t * SLAB_FAR_SCALE) { /* the box test's slack: ties are never culled */
+                    cur = stk_c[sp];
+                    cnt = stk_n[sp];
+                    alive = true;
                 }
             }
         }
         if (!alive) break;
-        for (uint j = n.index, end = n.index + n.count; j < end; ++j) {
+        for (uint j = cur, end = cur + cnt; j < end; ++j) {
             uvec3 tri = load_tri(g.tri_base + j); /* leaf order: no ref to follow */
             float t;
             if (!tri_intersect(r, load_vertex(tri.x), load_vertex(tri.y), load_vertex(tri.z), t)) continue;
@@ -501,7 +609,8 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
         while (sp > 0u && !alive) {
             --sp;
             if (stk_t[sp] <= h.t * SLAB_FAR_SCALE) { /* the box test's slack: ties are never culled */
-                n = load_node(g.node_base + stk_n[sp]);
+                cur = stk_c[sp];
+                cnt = stk_n[sp];
                 alive = true;
             }
         }

@@ -45,6 +45,8 @@ typedef struct rc__vk_pack_info {
     uint32_t top_node;     /* first node of the top level */
     uint32_t top_ref;      /* first ref of the top level */
     uint32_t flags;        /* 1: one mesh and no instances (no top level needed) */
+    uint32_t reserved0;
+    uint64_t max_wide;     /* wide nodes of the largest mesh section (rc__vk_pack_dst.wide_scratch) */
 } rc__vk_pack_info;
 
 /* A destination for one packed array: up to 4 chunks of 2^shift elements. */
@@ -57,6 +59,7 @@ typedef struct rc__vk_span {
 
 typedef struct rc__vk_pack_dst {
     rc__vk_span nodes, refs, tris, verts, geoms, insts;
+    rc__wnode *wide_scratch; /* rc__vk_pack_info.max_wide nodes: each mesh is collapsed here first */
 } rc__vk_pack_dst;
 
 /* A driver acceleration structure (ray query traversal) and its storage. */
@@ -272,7 +275,8 @@ void rc__vk_pack_section(const rc__vk_section *s, const rc__vk_pack_dst *dst);
  * records and the top level's nodes and refs (after rc__vk_pack_count). */
 void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
 
-/* Host copy of packed arrays (linear, one chunk each). */
+/* Host copy of packed arrays (linear, one chunk each). nodes holds each
+ * mesh's wide nodes (4 slots each) and the top level's binary ones. */
 typedef struct rc__vk_packed {
     rc__vk_pack_info info;
     const rc__bvh_node *nodes;

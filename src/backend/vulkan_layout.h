@@ -7,13 +7,14 @@
 #define RC_BACKEND_VULKAN_LAYOUT_H
 
 #include "bvh/bvh.h"
+#include "bvh/wide.h"
 
 #include <stddef.h>
 #include <stdint.h>
 
 /* One mesh in the concatenated scene arrays (GLSL: struct Geom). */
 typedef struct rc__vk_geom {
-    uint32_t node_base; /* its root is nodes[node_base]; child/leaf indices are relative */
+    uint32_t node_base; /* its wide root takes nodes[node_base .. + 4); wide node k slots node_base + 4k .. */
     uint32_t ref_base;  /* its refs start at refs[ref_base] */
     uint32_t tri_base;  /* leaf slot j's triangle is tris[tri_base + j] (leaf order, global vertex indices) */
     uint32_t geom_id;   /* geometry id within its own scene */
@@ -78,6 +79,9 @@ RC__VK_ASSERT(offsetof(rc__bvh_node, bmin) == 0, node_bmin);
 RC__VK_ASSERT(offsetof(rc__bvh_node, index) == 12, node_index);
 RC__VK_ASSERT(offsetof(rc__bvh_node, bmax) == 16, node_bmax);
 RC__VK_ASSERT(offsetof(rc__bvh_node, count) == 28, node_count);
+/* a mesh's wide node takes four node slots (kernels/layout.glsl, WNode) */
+RC__VK_ASSERT(sizeof(rc__wnode) == 4 * sizeof(rc__bvh_node), wnode_slots);
+RC__VK_ASSERT(offsetof(rc__wnode, child) == 96 && offsetof(rc__wnode, count) == 112, wnode_members);
 RC__VK_ASSERT(sizeof(rc__vk_geom) == 16, geom_size);
 RC__VK_ASSERT(offsetof(rc__vk_geom, tri_base) == 8, geom_tri_base);
 RC__VK_ASSERT(offsetof(rc__vk_geom, geom_id) == 12, geom_geom_id);

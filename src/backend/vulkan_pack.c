@@ -1,9 +1,13 @@
 /* Packing a committed scene into the flat arrays the kernels read (layout in
  * kernels/layout.glsl), and a C traversal of those arrays.
  *
- * The arrays are the canonical BVH, concatenated: every mesh's nodes and refs
- * as rc__bvh_build made them (child and leaf indices stay relative to the
- * mesh: the kernel adds node_base/ref_base), then the scene's top level. The
+ * The arrays are the canonical BVH, concatenated: every mesh's tree collapsed
+ * into the CPU's 4-wide nodes (bvh/wide.h, rc__wide_collapse: one 128-byte
+ * node takes four 32-byte node slots, 4-aligned, so it never straddles a
+ * binding) and its refs as rc__bvh_build made them (child and leaf indices
+ * stay relative to the mesh: the kernel adds node_base/ref_base), then the
+ * scene's top level in binary nodes. A mesh updated in place keeps its
+ * collapse's node count (a refit keeps the tree's shape), so its place. The
  * meshes are the scene's own geometries, then the geometries of every scene
  * its instances use, each such source once. Triangles are rewritten with
  * global vertex indices and vertices repacked to 3 floats whatever the input
@@ -17,6 +21,7 @@
 
 #include "bvh/intersect.h"
 
+#include <math.h>
 #include <string.h>
 
 static void span_write(const rc__vk_span *s, uint64_t first, const void *src, uint64_t count)
@@ -40,14 +45,29 @@ static rc__vk_scene *vk_scene_of(const rc_scene *scene) { return (rc__vk_scene *
  * sibling pairs (at odd indices within it) then fill whole 64-byte lines. */
 static uint64_t pair_aligned(uint64_t node) { return node | 1u; }
 
+/* Node slots one wide node takes, and a wide node's first slot at or after node. */
+#define WIDE_SLOTS 4u
+static uint64_t wide_aligned(uint64_t node) { return (node + WIDE_SLOTS - 1u) & ~(uint64_t)(WIDE_SLOTS - 1u); }
+
+/* Wide nodes of m's section: its collapse's (a count-only pass; a refit keeps
+ * it), at least one (an empty mesh's root). */
+static uint64_t wide_nodes_of(const rc__mesh *m)
+{
+    const uint32_t n = rc__wide_collapse(&m->bvh, NULL);
+    return n ? n : 1u;
+}
+
 typedef struct pack_cursor {
     uint64_t node, ref, tri, vert, geom;
+    uint64_t max_wide;
 } pack_cursor;
 
 /* Moves the cursor past m's sections, as fill_mesh does when it writes them. */
 static void skip_mesh(const rc__mesh *m, pack_cursor *c)
 {
-    c->node = pair_aligned(c->node) + m->bvh.node_count;
+    const uint64_t wide = wide_nodes_of(m);
+    if (wide > c->max_wide) c->max_wide = wide;
+    c->node = wide_aligned(c->node) + WIDE_SLOTS * wide;
     c->ref += m->bvh.item_count;
     c->tri += m->triangle_count;
     c->vert += m->vertex_count;
@@ -76,6 +96,7 @@ void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
     info->geoms = c.geom;
     info->insts = scene->inst_count;
     info->geom_count = scene->geom_count;
+    info->max_wide = c.max_wide;
     info->top_node = (uint32_t)pair_aligned(info->nodes);
     info->top_ref = (uint32_t)info->refs;
     info->nodes = info->top_node;
@@ -91,18 +112,29 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst
     rc__vk_geom entry;
     uint32_t batch[3u * PACK_BATCH];
     float vbatch[3u * PACK_BATCH];
+    const uint64_t wide = wide_nodes_of(m);
     uint32_t i, k, n;
-    if (c->node != pair_aligned(c->node)) { /* the padding node: never read */
+    while (c->node != wide_aligned(c->node)) { /* padding slots: never read */
         static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
         span_write(&dst->nodes, c->node, &pad, 1);
-        c->node = pair_aligned(c->node);
+        c->node++;
     }
     entry.node_base = (uint32_t)c->node;
     entry.ref_base = (uint32_t)c->ref;
     entry.tri_base = (uint32_t)c->tri;
     entry.geom_id = geom_id;
     span_write(&dst->geoms, c->geom, &entry, 1);
-    span_write(&dst->nodes, c->node, m->bvh.nodes, m->bvh.node_count);
+    if (rc__wide_collapse(&m->bvh, dst->wide_scratch) == 0) { /* no triangles: a root of empty slots */
+        rc__wnode *w = dst->wide_scratch;
+        for (i = 0; i < 4u; ++i) {
+            for (k = 0; k < 3u; ++k) {
+                w->box[2u * k][i] = INFINITY;
+                w->box[2u * k + 1u][i] = -INFINITY;
+            }
+            w->child[i] = RC__WIDE_EMPTY;
+        }
+    }
+    span_write(&dst->nodes, c->node, dst->wide_scratch, WIDE_SLOTS * wide);
     span_write(&dst->refs, c->ref, m->bvh.refs, m->bvh.item_count);
     for (i = 0; i < m->triangle_count; i += n) {
         n = m->triangle_count - i < PACK_BATCH ? m->triangle_count - i : PACK_BATCH;
@@ -183,7 +215,7 @@ static void note_section(const rc__mesh *m, uint32_t geom_id, int write, pack_cu
         s->geom_id = geom_id;
         s->geom = c->geom;
         s->node = c->node;
-        s->nodes = pair_aligned(c->node) + m->bvh.node_count - c->node;
+        s->nodes = wide_aligned(c->node) + WIDE_SLOTS * wide_nodes_of(m) - c->node;
         s->ref = c->ref;
         s->refs = m->bvh.item_count;
         s->tri = c->tri;
@@ -239,65 +271,23 @@ void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, c
 
 /* ---- the C traversal of the packed arrays -------------------------------------- */
 
-typedef struct packed_entry {
-    uint32_t node;
-    float tnear;
-} packed_entry;
-
+/* One mesh of the packed arrays, walked by the CPU's own wide traversal
+ * through a mesh that views them: its nodes where the section starts, its
+ * leaf-order triangles (global vertex indices into the packed vertices) and
+ * refs. */
 static int packed_mesh(const rc__vk_packed *p, uint32_t gi, uint32_t geom_id, uint32_t inst, const rc__ray *ray,
                        rc__hit *hit)
 {
     const rc__vk_geom g = p->geoms[gi];
-    const rc__bvh_node *nodes = p->nodes + g.node_base;
-    rc__slab_ray s;
-    packed_entry stack[RC__BVH_MAX_DEPTH];
-    uint32_t sp = 0, ni = 0;
-    float tn;
-    int found = 0;
-    rc__slab_ray_init(&s, ray);
-    if (!rc__node_hit(&nodes[0], &s, hit->t, &tn)) return 0;
-    for (;;) {
-        const rc__bvh_node *n = &nodes[ni];
-        if (n->count == 0) {
-            const uint32_t c = n->index;
-            float t0, t1;
-            const int h0 = rc__node_hit(&nodes[c], &s, hit->t, &t0);
-            const int h1 = rc__node_hit(&nodes[c + 1], &s, hit->t, &t1);
-            if (h0 && h1) {
-                ni = t1 < t0 ? c + 1 : c;
-                if (sp < RC__BVH_MAX_DEPTH) {
-                    stack[sp].node = t1 < t0 ? c : c + 1;
-                    stack[sp].tnear = t1 < t0 ? t0 : t1;
-                    ++sp;
-                }
-                continue;
-            }
-            if (h0 || h1) {
-                ni = h0 ? c : c + 1;
-                continue;
-            }
-        } else {
-            uint32_t j;
-            for (j = n->index; j < n->index + n->count; ++j) {
-                const uint32_t prim = p->refs[g.ref_base + j];
-                const uint32_t *tri = p->tris + (size_t)3u * (g.tri_base + j);
-                float t, u, v;
-                if (!rc__tri_intersect(ray, p->verts + (size_t)3u * tri[0], p->verts + (size_t)3u * tri[1],
-                                       p->verts + (size_t)3u * tri[2], &t, &u, &v))
-                    continue;
-                /* slot unknown: the packed arrays have their own order */
-                if (rc__hit_offer(hit, t, u, v, prim, RC_INVALID_ID, geom_id, inst)) found = 1;
-            }
-        }
-        for (;;) {
-            if (sp == 0) return found;
-            --sp;
-            if (stack[sp].tnear <= hit->t * RC__SLAB_FAR_SCALE) { /* ties are never culled */
-                ni = stack[sp].node;
-                break;
-            }
-        }
-    }
+    rc__mesh view;
+    memset(&view, 0, sizeof view);
+    view.vertices = p->verts;
+    view.stride = 3;
+    view.bvh.refs = (uint32_t *)(uintptr_t)(p->refs + g.ref_base); /* only read */
+    view.leaf_tris = p->tris + (size_t)3u * g.tri_base;
+    view.wide = (const rc__wnode *)(const void *)(p->nodes + g.node_base);
+    view.wide_count = 1; /* any non-zero: the walk follows child indices */
+    return rc__mesh_intersect_wide(&view, ray, geom_id, inst, hit);
 }
 
 int rc__vk_packed_intersect(const rc__vk_packed *p, const rc__ray *ray, rc__hit *hit)

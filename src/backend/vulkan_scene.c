@@ -148,6 +148,17 @@ static rc_status copy_chunked(rc__vk_state *st, const rc__vk_buffer *staging, Vk
     return RC_OK;
 }
 
+/* Host memory the pack collapses each mesh's tree into (info->max_wide nodes). */
+static rc_status wide_scratch(rc__vk_state *st, const rc__vk_pack_info *info, rc__wnode **out)
+{
+    const uint64_t bytes = info->max_wide * sizeof(rc__wnode);
+    *out = bytes == (size_t)bytes ? (rc__wnode *)rc__vk_host_alloc(st, (size_t)(bytes ? bytes : 1u)) : NULL;
+    RC_RETURN_IF(st->ctx, *out == NULL, RC_ERR_OUT_OF_MEMORY,
+                 "rc_scene_commit: no host memory to collapse a mesh's BVH for Vulkan (%llu bytes)",
+                 (unsigned long long)bytes);
+    return RC_OK;
+}
+
 /* Upper bound of the meshes rc__vk_pack_changed can name (a source
  * instanced twice counts twice). */
 static uint32_t sections_bound(const rc_scene *scene)
@@ -181,7 +192,7 @@ static rc__vk_span span_section(const rc__vk_buffer *staging, uint64_t off, uint
 /* Writes the meshes' sections into staging from off on and copies them into the
  * device arrays (discrete GPUs: only what changed crosses the bus). */
 static rc_status stage_sections(rc__vk_state *st, rc__vk_scene *sv, const rc__vk_section *m, uint32_t n,
-                                const rc__vk_buffer *staging, uint64_t off)
+                                const rc__vk_buffer *staging, uint64_t off, rc__wnode *scratch)
 {
     uint32_t k;
     rc_status s = RC_OK;
@@ -196,6 +207,7 @@ static rc_status stage_sections(rc__vk_state *st, rc__vk_scene *sv, const rc__vk
         dst.refs = span_section(staging, o_ref, m[k].ref, 4u);
         dst.tris = span_section(staging, o_tri, m[k].tri, 12u);
         dst.verts = span_section(staging, o_vert, m[k].vert, 12u);
+        dst.wide_scratch = scratch;
         rc__vk_pack_section(&m[k], &dst);
         s = rc__vk_copy_region(st, staging, &sv->geoms, o_geom, m[k].geom * sizeof(rc__vk_geom),
                                sizeof(rc__vk_geom));
@@ -244,6 +256,13 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
         n = rc__vk_pack_changed(scene, serial, changed, meshes, bound);
     }
     memset(&dst, 0, sizeof dst);
+    if (n) {
+        s = wide_scratch(st, &info, &dst.wide_scratch);
+        if (s != RC_OK) {
+            rc__vk_host_free(st, meshes);
+            return s;
+        }
+    }
     if (st->device_mappable) {
         dst.nodes = span_over(sv->nodes, sv->node_chunks, st->node_shift, (uint32_t)sizeof(rc__bvh_node));
         dst.tris = span_over(sv->tris, sv->tri_chunks, st->tri_shift, 12u);
@@ -277,7 +296,7 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
             info.top_node = (uint32_t)(node_off / sizeof(rc__bvh_node));
             info.top_ref = (uint32_t)(ref_off / 4u);
             rc__vk_pack_fill_top(scene, &info, &dst);
-            s = stage_sections(st, sv, meshes, n, &staging, mesh_off);
+            s = stage_sections(st, sv, meshes, n, &staging, mesh_off, dst.wide_scratch);
             if (s == RC_OK && inst_bytes) s = rc__vk_copy_region(st, &staging, &sv->insts, 0, 0, inst_bytes);
             if (s == RC_OK)
                 s = copy_chunked(st, &staging, node_off, sv->nodes, st->node_shift, (uint32_t)sizeof(rc__bvh_node),
@@ -289,6 +308,7 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
         }
     }
     rc__vk_host_free(st, meshes);
+    rc__vk_host_free(st, dst.wide_scratch);
     if (s == RC_OK && st->ray_query)
         s = rc__vk_accel_update(scene, serial, changed);
     return s;
@@ -412,7 +432,13 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
     span_of(&arrays[3], st->device_mappable ? NULL : &staging, &dst.refs);
     span_of(&arrays[4], st->device_mappable ? NULL : &staging, &dst.geoms);
     span_of(&arrays[5], st->device_mappable ? NULL : &staging, &dst.insts);
+    s = wide_scratch(st, &info, &dst.wide_scratch);
+    if (s != RC_OK) {
+        rc__vk_buffer_destroy(st, &staging);
+        goto fail;
+    }
     rc__vk_pack_fill(scene, serial, &info, &dst);
+    rc__vk_host_free(st, dst.wide_scratch);
 
     for (a = 0; a < 6 && s == RC_OK; ++a)
         for (c = 0; c < arrays[a].chunks && s == RC_OK; ++c) {

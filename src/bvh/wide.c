@@ -66,7 +66,7 @@ static uint32_t emit(collapse_ctx *cc, uint32_t b)
             kids[k++] = bin[open].index + 1u;
         }
     }
-    for (c = 0; c < 4; ++c) {
+    for (c = 0; c < 4 && cc->out; ++c) {
         rc__wnode *node = &cc->out[w];
         if (c >= k) {
             slot_empty(node, (int)c);
@@ -84,7 +84,7 @@ static uint32_t emit(collapse_ctx *cc, uint32_t b)
     for (c = 0; c < k; ++c)
         if (bin[kids[c]].count == 0) {
             const uint32_t child = emit(cc, kids[c]);
-            cc->out[w].child[c] = child;
+            if (cc->out) cc->out[w].child[c] = child;
         }
     return w;
 }

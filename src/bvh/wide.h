@@ -36,8 +36,8 @@ uint32_t rc__wide_node_bound(uint32_t leaves);
 
 /* Collapses bin (leaves of bin hold items refs[index .. index + count)) into
  * out, which holds rc__wide_node_bound(leaves) nodes. Returns the node count
- * (0 for an empty tree). Deterministic: the child with the largest surface
- * area is opened first, ties to the lower slot. */
+ * (0 for an empty tree); out NULL only counts. Deterministic: the child with
+ * the largest surface area is opened first, ties to the lower slot. */
 uint32_t rc__wide_collapse(const rc__bvh *bin, rc__wnode *out);
 
 /* Recomputes every box bottom-up from the triangles: leaf slot j holds the
