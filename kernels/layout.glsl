@@ -7,7 +7,8 @@
  * kernels/layout_check.comp read them back member by member, so a mismatch on
  * either side fails the build or that test.
  *
- *   Node  (32 bytes) = rc__bvh_node, the canonical BVH node, uploaded as is:
+ *   Node  (32 bytes) = rc__bvh_node, the canonical BVH node, uploaded as is
+ *         for the top level:
  *           off  0 vec3 bmin   | off 12 uint index
  *           off 16 vec3 bmax   | off 28 uint count
  *         interior: count == 0, children nodes[base + index], nodes[base + index + 1]

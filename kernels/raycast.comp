@@ -1,7 +1,8 @@
 /* rangecast: one invocation per ray. Generates the ray (grid models from the
  * per-axis tables, O1Dn/OnDn from the uploaded table), moves it into the map
  * frame with its pose's transform, finds the nearest hit in the scene's
- * two-level BVH (the canonical layout of src/bvh/bvh.h, uploaded as is) and
+ * two-level BVH (the canonical layout of src/bvh/bvh.h: the top level's
+ * binary nodes, each mesh's tree as the 4-wide nodes of src/bvh/wide.h) and
  * writes the requested attributes with the CPU backend's exact semantics
  * (src/backend/results.c); for results kept on the device it also applies
  * the sensor's range noise (noise.glsl), which host results get on the host.

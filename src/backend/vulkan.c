@@ -1,5 +1,6 @@
 /* The Vulkan compute backend: the scene's canonical two-level BVH (the same
- * one the BVH backend builds) packed into storage buffers and traversed by a
+ * one the BVH backend builds; each mesh's tree collapsed into the same 4-wide
+ * nodes the BVH backend walks) packed into storage buffers and traversed by a
  * GLSL 450 compute kernel (kernels/raycast.comp, embedded as SPIR-V), one
  * invocation per ray, the whole batch of poses in one dispatch (or a few when
  * the result buffers' size forces it).
