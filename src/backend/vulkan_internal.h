@@ -93,6 +93,10 @@ typedef struct rc__vk_scene {
      * level (vulkan_scene.c) */
     uint32_t current;
     uint32_t full_uploads, top_updates, mesh_updates; /* commits of each kind (test hook) */
+    /* wide nodes of each own mesh's collapse (rc__vk_wide_counts, kept so a
+     * commit that only moves instances does not walk every tree again) */
+    uint32_t *wide_nodes;      /* wide_cap entries, from the driver's host allocator */
+    uint32_t wide_cap;
 } rc__vk_scene;
 
 typedef struct rc__vk_pipeline {
@@ -248,8 +252,13 @@ const uint32_t *rc__vk_layout_check_spirv(size_t *bytes);
 
 /* vulkan_pack.c ----------------------------------------------------------- */
 
-/* Counts the packed arrays of a scene whose BVH is built; tags the instance
- * sources' rc__vk_scene with serial. */
+/* After a build: the wide node count of every own mesh whose tree changed
+ * (changed[g]; all of them for changed NULL or a first count). *moved 1 when
+ * a count changed (a rebuilt tree of another shape) or all were taken: the
+ * sections after it move, so the packed layout cannot be kept. */
+rc_status rc__vk_wide_counts(rc__vk_state *st, rc_scene *scene, const uint8_t *changed, int *moved);
+/* Counts the packed arrays of a scene whose BVH is built (and its wide node
+ * counts taken); tags the instance sources' rc__vk_scene with serial. */
 void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info);
 /* Writes them (after rc__vk_pack_count with the same serial). */
 void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst);
@@ -261,6 +270,7 @@ typedef struct rc__vk_section {
     uint32_t geom_id;   /* within its own scene */
     uint64_t geom;      /* its geometry record */
     uint64_t node, nodes, ref, refs, tri, tris, vert, verts;
+    uint64_t wide;      /* its wide nodes */
 } rc__vk_section;
 /* The meshes a commit that keeps the layout must write again: own geometry g
  * where changed[g], and every mesh of an instanced source re-committed since

@@ -49,11 +49,12 @@ static uint64_t pair_aligned(uint64_t node) { return node | 1u; }
 #define WIDE_SLOTS 4u
 static uint64_t wide_aligned(uint64_t node) { return (node + WIDE_SLOTS - 1u) & ~(uint64_t)(WIDE_SLOTS - 1u); }
 
-/* Wide nodes of m's section: its collapse's (a count-only pass; a refit keeps
- * it), at least one (an empty mesh's root). */
-static uint64_t wide_nodes_of(const rc__mesh *m)
+/* Wide nodes of geometry g's section in its own scene: its collapse's count,
+ * which that scene's commit keeps (rc__vk_wide_counts), at least one (an
+ * empty mesh's root). */
+static uint64_t wide_of(const rc_scene *owner, uint32_t g)
 {
-    const uint32_t n = rc__wide_collapse(&m->bvh, NULL);
+    const uint32_t n = vk_scene_of(owner)->wide_nodes[g];
     return n ? n : 1u;
 }
 
@@ -62,10 +63,9 @@ typedef struct pack_cursor {
     uint64_t max_wide;
 } pack_cursor;
 
-/* Moves the cursor past m's sections, as fill_mesh does when it writes them. */
-static void skip_mesh(const rc__mesh *m, pack_cursor *c)
+/* Moves the cursor past m's sections (wide nodes), as fill_mesh does when it writes them. */
+static void skip_mesh(const rc__mesh *m, uint64_t wide, pack_cursor *c)
 {
-    const uint64_t wide = wide_nodes_of(m);
     if (wide > c->max_wide) c->max_wide = wide;
     c->node = wide_aligned(c->node) + WIDE_SLOTS * wide;
     c->ref += m->bvh.item_count;
@@ -74,20 +74,47 @@ static void skip_mesh(const rc__mesh *m, pack_cursor *c)
     c->geom += 1u;
 }
 
+rc_status rc__vk_wide_counts(rc__vk_state *st, rc_scene *scene, const uint8_t *changed, int *moved)
+{
+    rc__vk_scene *sv = vk_scene_of(scene);
+    uint32_t g;
+    int all = changed == NULL;
+    *moved = 0;
+    if (sv->wide_cap < scene->geom_count) {
+        const uint32_t cap = scene->geom_count;
+        uint32_t *n = (uint32_t *)rc__vk_host_alloc(st, (size_t)cap * sizeof *n);
+        RC_RETURN_IF(st->ctx, n == NULL, RC_ERR_OUT_OF_MEMORY,
+                     "rc_scene_commit: no host memory for the Vulkan node counts of %u meshes", (unsigned)cap);
+        rc__vk_host_free(st, sv->wide_nodes);
+        sv->wide_nodes = n;
+        sv->wide_cap = cap;
+        all = 1;
+    }
+    for (g = 0; g < scene->geom_count; ++g) {
+        uint32_t n;
+        if (!all && !changed[g]) continue;
+        n = rc__wide_collapse(&scene->geoms[g].mesh.bvh, NULL);
+        *moved |= n != sv->wide_nodes[g];
+        sv->wide_nodes[g] = n;
+    }
+    *moved |= all;
+    return RC_OK;
+}
+
 void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
 {
     pack_cursor c;
     uint32_t g, i;
     memset(info, 0, sizeof *info);
     memset(&c, 0, sizeof c);
-    for (g = 0; g < scene->geom_count; ++g) skip_mesh(&scene->geoms[g].mesh, &c);
+    for (g = 0; g < scene->geom_count; ++g) skip_mesh(&scene->geoms[g].mesh, wide_of(scene, g), &c);
     for (i = 0; i < scene->inst_count; ++i) {
         const rc_scene *src = scene->insts[i].source;
         rc__vk_scene *sv = vk_scene_of(src);
         if (sv->pack_serial == serial) continue;
         sv->pack_serial = serial;
         sv->pack_first_geom = (uint32_t)c.geom;
-        for (g = 0; g < src->geom_count; ++g) skip_mesh(&src->geoms[g].mesh, &c);
+        for (g = 0; g < src->geom_count; ++g) skip_mesh(&src->geoms[g].mesh, wide_of(src, g), &c);
     }
     info->nodes = c.node;
     info->refs = c.ref;
@@ -107,12 +134,12 @@ void rc__vk_pack_count(rc_scene *scene, uint32_t serial, rc__vk_pack_info *info)
 
 #define PACK_BATCH 512u
 
-static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst *dst, pack_cursor *c)
+static void fill_mesh(const rc__mesh *m, uint32_t geom_id, uint64_t wide, const rc__vk_pack_dst *dst,
+                      pack_cursor *c)
 {
     rc__vk_geom entry;
     uint32_t batch[3u * PACK_BATCH];
     float vbatch[3u * PACK_BATCH];
-    const uint64_t wide = wide_nodes_of(m);
     uint32_t i, k, n;
     while (c->node != wide_aligned(c->node)) { /* padding slots: never read */
         static const rc__bvh_node pad = {{0.0f, 0.0f, 0.0f}, 0u, {0.0f, 0.0f, 0.0f}, 0u};
@@ -157,7 +184,7 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, const rc__vk_pack_dst
         for (k = 0; k < n; ++k) memcpy(vbatch + 3u * k, m->vertices + (size_t)(i + k) * m->stride, 3 * sizeof(float));
         span_write(&dst->verts, c->vert + i, vbatch, n);
     }
-    skip_mesh(m, c);
+    skip_mesh(m, wide, c);
 }
 
 /* Instance i's record: its transforms and where its source's meshes are
@@ -189,13 +216,14 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
     pack_cursor c;
     uint32_t g, i;
     memset(&c, 0, sizeof c);
-    for (g = 0; g < scene->geom_count; ++g) fill_mesh(&scene->geoms[g].mesh, g, dst, &c);
+    for (g = 0; g < scene->geom_count; ++g) fill_mesh(&scene->geoms[g].mesh, g, wide_of(scene, g), dst, &c);
     for (i = 0; i < scene->inst_count; ++i) {
         const rc__instance *in = &scene->insts[i];
         rc__vk_scene *sv = vk_scene_of(in->source);
         if (sv->fill_serial != serial) { /* first use of this source: its meshes go here */
             sv->fill_serial = serial;
-            for (g = 0; g < in->source->geom_count; ++g) fill_mesh(&in->source->geoms[g].mesh, g, dst, &c);
+            for (g = 0; g < in->source->geom_count; ++g)
+                fill_mesh(&in->source->geoms[g].mesh, g, wide_of(in->source, g), dst, &c);
         }
     }
     if (c.node < info->top_node) {
@@ -206,16 +234,19 @@ void rc__vk_pack_fill(rc_scene *scene, uint32_t serial, const rc__vk_pack_info *
 }
 
 /* Appends m's section at cursor c to out (while there is room) and moves c past it. */
-static void note_section(const rc__mesh *m, uint32_t geom_id, int write, pack_cursor *c, rc__vk_section *out,
+static void note_section(const rc_scene *owner, uint32_t geom_id, int write, pack_cursor *c, rc__vk_section *out,
                          uint32_t max, uint32_t *n)
 {
+    const rc__mesh *m = &owner->geoms[geom_id].mesh;
+    const uint64_t wide = wide_of(owner, geom_id);
     if (write && *n < max) {
         rc__vk_section *s = &out[*n];
         s->mesh = m;
         s->geom_id = geom_id;
         s->geom = c->geom;
         s->node = c->node;
-        s->nodes = wide_aligned(c->node) + WIDE_SLOTS * wide_nodes_of(m) - c->node;
+        s->nodes = wide_aligned(c->node) + WIDE_SLOTS * wide - c->node;
+        s->wide = wide;
         s->ref = c->ref;
         s->refs = m->bvh.item_count;
         s->tri = c->tri;
@@ -224,7 +255,7 @@ static void note_section(const rc__mesh *m, uint32_t geom_id, int write, pack_cu
         s->verts = m->vertex_count;
     }
     *n += write ? 1u : 0u;
-    skip_mesh(m, c);
+    skip_mesh(m, wide, c);
 }
 
 uint32_t rc__vk_pack_changed(rc_scene *scene, uint32_t serial, const uint8_t *changed, rc__vk_section *out,
@@ -233,7 +264,7 @@ uint32_t rc__vk_pack_changed(rc_scene *scene, uint32_t serial, const uint8_t *ch
     pack_cursor c;
     uint32_t g, i, n = 0;
     memset(&c, 0, sizeof c);
-    for (g = 0; g < scene->geom_count; ++g) note_section(&scene->geoms[g].mesh, g, changed[g] != 0, &c, out, max, &n);
+    for (g = 0; g < scene->geom_count; ++g) note_section(scene, g, changed[g] != 0, &c, out, max, &n);
     for (i = 0; i < scene->inst_count; ++i) {
         const rc_scene *source = scene->insts[i].source;
         rc__vk_scene *sv = vk_scene_of(source);
@@ -241,7 +272,7 @@ uint32_t rc__vk_pack_changed(rc_scene *scene, uint32_t serial, const uint8_t *ch
         const int moved = source->version != scene->source_versions[i];
         if (sv->fill_serial == serial) continue;
         sv->fill_serial = serial;
-        for (g = 0; g < source->geom_count; ++g) note_section(&source->geoms[g].mesh, g, moved, &c, out, max, &n);
+        for (g = 0; g < source->geom_count; ++g) note_section(source, g, moved, &c, out, max, &n);
     }
     return n;
 }
@@ -254,7 +285,7 @@ void rc__vk_pack_section(const rc__vk_section *s, const rc__vk_pack_dst *dst)
     c.tri = s->tri;
     c.vert = s->vert;
     c.geom = s->geom;
-    fill_mesh(s->mesh, s->geom_id, dst, &c);
+    fill_mesh(s->mesh, s->geom_id, s->wide, dst, &c);
 }
 
 void rc__vk_pack_fill_top(const rc_scene *scene, const rc__vk_pack_info *info, const rc__vk_pack_dst *dst)

@@ -49,6 +49,7 @@ void rc__vk_scene_release(rc_scene *scene)
     rc__vk_scene *sv = (rc__vk_scene *)scene->backend_scene;
     if (!sv) return;
     release_buffers(rc__vk(scene->ctx), sv);
+    rc__vk_host_free(rc__vk(scene->ctx), sv->wide_nodes);
     rc__arena_free(&scene->ctx->arena, sv);
     scene->backend_scene = NULL;
 }
@@ -338,14 +339,17 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
     }
     {
         /* what the last upload lets this commit keep, judged before the build */
-        int in_place = layout_kept(scene, sv), changed_meshes = 0, done = 0;
-        uint8_t *changed = in_place ? (uint8_t *)rc__vk_host_alloc(st, scene->geom_count + 1u) : NULL;
+        int in_place = layout_kept(scene, sv), changed_meshes = 0, done = 0, moved = 0;
+        uint8_t *changed = (uint8_t *)rc__vk_host_alloc(st, scene->geom_count + 1u);
         if (changed) changed_meshes = meshes_changed(scene, changed);
         /* what changed is rewritten in place: directly where device memory
          * is mapped (UMA boards, lavapipe), else through staging */
-        in_place = changed != NULL;
+        in_place = in_place && changed != NULL;
         sv->current = 0; /* until this commit succeeds */
         s = rc__scene_build_bvh(scene, progress, user);
+        /* the trees built again: their wide node counts (all without the marks) */
+        if (s == RC_OK) s = rc__vk_wide_counts(st, scene, changed, &moved);
+        if (moved) in_place = 0;
         if (s == RC_OK && in_place) {
             s = update_in_place(st, scene, sv, changed_meshes ? changed : NULL, &done);
             if (s != RC_OK) release_buffers(st, sv);
