@@ -59,7 +59,9 @@ typedef struct rc__vk_span {
 
 typedef struct rc__vk_pack_dst {
     rc__vk_span nodes, refs, tris, verts, geoms, insts;
-    rc__wnode *wide_scratch; /* rc__vk_pack_info.max_wide nodes: each mesh is collapsed here first */
+    rc__wnode *wide_scratch; /* rc__vk_pack_info.max_wide nodes where nodes has several chunks (a
+                              * section may straddle two): each mesh is collapsed here first; NULL
+                              * for one chunk: collapsed in place */
 } rc__vk_pack_dst;
 
 /* A driver acceleration structure (ray query traversal) and its storage. */

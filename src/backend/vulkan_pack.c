@@ -39,6 +39,13 @@ static void span_write(const rc__vk_span *s, uint64_t first, const void *src, ui
     }
 }
 
+/* Where element first of a span lies. */
+static unsigned char *span_at(const rc__vk_span *s, uint64_t first)
+{
+    const uint64_t i = first - s->base;
+    return s->chunk[i >> s->shift] + (i & (((uint64_t)1 << s->shift) - 1u)) * s->elem_size;
+}
+
 static rc__vk_scene *vk_scene_of(const rc_scene *scene) { return (rc__vk_scene *)scene->backend_scene; }
 
 /* Every BVH starts at an odd node index, as in the scene's own block: its
@@ -138,6 +145,7 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, uint64_t wide, const 
                       pack_cursor *c)
 {
     rc__vk_geom entry;
+    rc__wnode *out;
     uint32_t batch[3u * PACK_BATCH];
     float vbatch[3u * PACK_BATCH];
     uint32_t i, k, n;
@@ -151,8 +159,11 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, uint64_t wide, const 
     entry.tri_base = (uint32_t)c->tri;
     entry.geom_id = geom_id;
     span_write(&dst->geoms, c->geom, &entry, 1);
-    if (rc__wide_collapse(&m->bvh, dst->wide_scratch) == 0) { /* no triangles: a root of empty slots */
-        rc__wnode *w = dst->wide_scratch;
+    /* straight into place when the section cannot straddle two bindings
+     * (no scratch given: the array is one binding), else through the scratch */
+    out = dst->wide_scratch ? dst->wide_scratch : (rc__wnode *)(void *)span_at(&dst->nodes, c->node);
+    if (rc__wide_collapse(&m->bvh, out) == 0) { /* no triangles: a root of empty slots */
+        rc__wnode *w = out;
         for (i = 0; i < 4u; ++i) {
             for (k = 0; k < 3u; ++k) {
                 w->box[2u * k][i] = INFINITY;
@@ -161,7 +172,7 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, uint64_t wide, const 
             w->child[i] = RC__WIDE_EMPTY;
         }
     }
-    span_write(&dst->nodes, c->node, dst->wide_scratch, WIDE_SLOTS * wide);
+    if (out == dst->wide_scratch) span_write(&dst->nodes, c->node, out, WIDE_SLOTS * wide);
     span_write(&dst->refs, c->ref, m->bvh.refs, m->bvh.item_count);
     for (i = 0; i < m->triangle_count; i += n) {
         n = m->triangle_count - i < PACK_BATCH ? m->triangle_count - i : PACK_BATCH;

@@ -149,10 +149,15 @@ static rc_status copy_chunked(rc__vk_state *st, const rc__vk_buffer *staging, Vk
     return RC_OK;
 }
 
-/* Host memory the pack collapses each mesh's tree into (info->max_wide nodes). */
-static rc_status wide_scratch(rc__vk_state *st, const rc__vk_pack_info *info, rc__wnode **out)
+/* Host memory the pack collapses each mesh's tree into (info->max_wide
+ * nodes), needed only where the nodes span several bindings (chunks > 1): a
+ * section may then straddle two; else NULL, and each tree is collapsed in
+ * place. */
+static rc_status wide_scratch(rc__vk_state *st, const rc__vk_pack_info *info, uint32_t chunks, rc__wnode **out)
 {
     const uint64_t bytes = info->max_wide * sizeof(rc__wnode);
+    *out = NULL;
+    if (chunks <= 1) return RC_OK;
     *out = bytes == (size_t)bytes ? (rc__wnode *)rc__vk_host_alloc(st, (size_t)(bytes ? bytes : 1u)) : NULL;
     RC_RETURN_IF(st->ctx, *out == NULL, RC_ERR_OUT_OF_MEMORY,
                  "rc_scene_commit: no host memory to collapse a mesh's BVH for Vulkan (%llu bytes)",
@@ -258,7 +263,8 @@ static rc_status update_in_place(rc__vk_state *st, rc_scene *scene, rc__vk_scene
     }
     memset(&dst, 0, sizeof dst);
     if (n) {
-        s = wide_scratch(st, &info, &dst.wide_scratch);
+        /* staged sections are one chunk each */
+        s = wide_scratch(st, &info, st->device_mappable ? sv->node_chunks : 1u, &dst.wide_scratch);
         if (s != RC_OK) {
             rc__vk_host_free(st, meshes);
             return s;
@@ -436,7 +442,7 @@ rc_status rc__vk_scene_commit(rc_scene *scene, rc_progress_fn progress, void *us
     span_of(&arrays[3], st->device_mappable ? NULL : &staging, &dst.refs);
     span_of(&arrays[4], st->device_mappable ? NULL : &staging, &dst.geoms);
     span_of(&arrays[5], st->device_mappable ? NULL : &staging, &dst.insts);
-    s = wide_scratch(st, &info, &dst.wide_scratch);
+    s = wide_scratch(st, &info, arrays[0].chunks, &dst.wide_scratch);
     if (s != RC_OK) {
         rc__vk_buffer_destroy(st, &staging);
         goto fail;
