@@ -328,6 +328,60 @@ static void check_ordered(uint32_t backend, const rcu_mesh *sphere, const rcu_me
     rct_buffers_free(&got);
 }
 
+/* Instances (on the built-in backend single rays through the top level):
+ * the sphere as the scene's own mesh, which gives the key (tree or grid),
+ * and the box as two turned instances of a scene of its own; ordered calls
+ * on 1..3 threads match scan order on 1 and borrow their scratch. */
+static void check_ordered_instanced(uint32_t backend, const rcu_mesh *sphere, const rcu_mesh *box,
+                                    const rc_pose *poses)
+{
+    const uint64_t n = (uint64_t)POSES * 16u * 900u;
+    rct_buffers want, got;
+    uint32_t threads, i, id;
+    rct_buffers_alloc(&want, n, RC_ATTR_ALL);
+    rct_buffers_alloc(&got, n, RC_ATTR_ALL);
+    for (threads = 1; threads <= 3; ++threads) {
+        rc_context *ctx = rct_context(backend, threads, 64);
+        rc_scene_desc sd = rc_scene_desc_default();
+        rc_mesh_desc md = rc_mesh_desc_default();
+        rc_scene *src, *scene;
+        rc_sensor *sensor;
+        uint64_t borrowed;
+        ctx->large_mesh_bytes = 0;
+        src = rct_scene_meshes(ctx, &box, 1u);
+        sd.max_triangles = sphere->triangle_count;
+        sd.max_instances = 2;
+        RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+        md.vertices = sphere->vertices;
+        md.vertex_count = sphere->vertex_count;
+        md.indices = sphere->indices;
+        md.triangle_count = sphere->triangle_count;
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+        for (i = 0; i < 2u; ++i) {
+            rc_instance_desc in = rc_instance_desc_default();
+            in.source = src;
+            in.transform = rct_pose_ypr(i ? -9.0f : 0.0f, i ? 4.0f : 0.0f, 0.0f, 0.4 * i, 0.0, 0.1);
+            RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
+        }
+        RCT_OK(ctx, rc_scene_commit(scene));
+        sensor = make_sensor(ctx, 0);
+        if (threads == 1) {
+            ctx->ordered_mesh_bytes = UINT64_MAX;
+            assert_int_equal(simulate_all(ctx, scene, sensor, poses, &want), 0);
+        }
+        ctx->ordered_mesh_bytes = 0;
+        borrowed = simulate_all(ctx, scene, sensor, poses, &got);
+        assert_true(borrowed >= (uint64_t)threads * 16u * 900u * ((POSES + threads - 1u) / threads));
+        rct_assert_same_results(&want, &got);
+        rc_sensor_destroy(sensor);
+        rc_scene_destroy(scene);
+        rc_scene_destroy(src);
+        rc_context_destroy(ctx);
+    }
+    rct_buffers_free(&want);
+    rct_buffers_free(&got);
+}
+
 static void random_poses(rc_pose *poses)
 {
     uint32_t p;
@@ -366,6 +420,7 @@ static void test_ordered_matches_scan_order(void **state)
          * searched too */
         check_ordered(backend, &sphere, &box, poses, 0);
         check_ordered(backend, &sphere, &box, poses, 1);
+        check_ordered_instanced(backend, &sphere, &box, poses);
     }
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&box);

@@ -267,8 +267,9 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     trace_tiles(run, recs, 0u, count, pose0, worlds);
 }
 
-/* Sets up an ordered run when it pays: a mesh larger than the cache, and
- * enough tiles a task to meet its subtrees more than once. The scratch is
+/* Sets up an ordered run when it pays: an own mesh larger than the cache
+ * (with instances too: a map and the objects moving in it), and enough tiles
+ * a task to meet its subtrees more than once. The scratch is
  * borrowed from the arena's free space for the call; without room the call
  * runs in scan order (the same results). Returns 1 when run->order_scratch
  * was allocated. */
@@ -277,8 +278,9 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     const rc_scene *scene = job->scene;
     uint32_t threads = ctx->thread_count, g, chunk;
     uint64_t biggest = 0;
-    /* packets, or OnDn runs of 16 rays going mesh by mesh: both trace tiles */
-    if ((!run->packets && !run->rays_by_mesh) || !run->large) return 0;
+    /* every path traces tiles: packets, OnDn runs going mesh by mesh, and
+     * single rays through the top level (instances); the key is the biggest
+     * own mesh's, the map a scene's instances move in */
     for (g = 0; g < scene->geom_count; ++g) {
         const rc__mesh *mesh = &scene->geoms[g].mesh;
         const uint64_t bytes = rc__mesh_bytes(mesh);
@@ -287,7 +289,8 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
             run->order_mesh = g;
         }
     }
-    if (biggest <= ctx->ordered_mesh_bytes) return 0;
+    /* larger than the cache, and large enough that packets take turns */
+    if (biggest <= ctx->ordered_mesh_bytes || biggest <= ctx->large_mesh_bytes) return 0;
     chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles);
     if (chunk == 0) return 0;
     run->chunk_poses = chunk;

@@ -513,18 +513,19 @@ uint64_t rc__emb_mesh_array_bytes(const rc_scene *scene)
     return bytes;
 }
 
-/* The occupancy grid of a scene large enough for ordered runs (and without
- * instances, which it does not see): made at its first such commit, made
- * again when the triangle count or the bounds change. A mesh moved within
- * the bounds leaves it stale, which only costs order (so a commit after
- * updating a small mesh stays cheap). No grid where the budget has no room
- * for it: the calls then run scan by scan. */
+/* The occupancy grid of a scene whose own meshes are large enough for
+ * ordered runs: made at its first such commit, made again when the triangle
+ * count changes, or the bounds where the scene has no instances. A mesh moved
+ * within the bounds leaves it stale, which only costs order (so a commit
+ * after updating a small mesh stays cheap); so do instances (the grid does
+ * not see them), whose moves would otherwise make every commit of a dynamic
+ * map walk the whole map again. No grid where the budget has no room for it:
+ * the calls then run scan by scan. */
 static void update_occupancy(rc__emb_device *d, rc__emb_scene *es, const rc_scene *scene)
 {
     rc__occupancy *g = es->occupancy;
     const uint64_t budget = d->options.budget_bytes;
-    if (scene->inst_count != 0 || scene->geom_count == 0 ||
-        d->options.bytes_now + rc__emb_mesh_array_bytes(scene) <= scene->ctx->large_mesh_bytes)
+    if (scene->geom_count == 0 || d->options.bytes_now + rc__emb_mesh_array_bytes(scene) <= scene->ctx->large_mesh_bytes)
         return;
     if (!g) {
         if (budget != 0 && d->options.bytes_now + sizeof *g > budget) return;
@@ -534,7 +535,8 @@ static void update_occupancy(rc__emb_device *d, rc__emb_scene *es, const rc_scen
             return;
         }
         es->occupancy = g;
-    } else if (g->triangles == scene->triangle_count && memcmp(g->bounds, &scene->bounds, sizeof g->bounds) == 0) {
+    } else if (g->triangles == scene->triangle_count &&
+               (scene->inst_count != 0 || memcmp(g->bounds, &scene->bounds, sizeof g->bounds) == 0)) {
         return;
     }
     rc__occupancy_build(g, scene);

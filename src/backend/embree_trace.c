@@ -458,8 +458,7 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
      * scratch borrowed from the arena (without room, scan by scan) */
     run.chunk_poses = 0;
     run.order_scratch = NULL;
-    if (run.es->occupancy && job->scene->inst_count == 0 &&
-        d->options.bytes_now + context_mesh_bytes(ctx) > ctx->ordered_mesh_bytes)
+    if (run.es->occupancy && d->options.bytes_now + context_mesh_bytes(ctx) > ctx->ordered_mesh_bytes)
         run.chunk_poses = rc__order_chunk_poses(job->pose_count, threads, run.tiles_per_pose);
     if (run.chunk_poses) {
         run.order_scratch_stride = rc__order_scratch_bytes(run.chunk_poses, run.tiles_per_pose, sizeof(rc__xformf));

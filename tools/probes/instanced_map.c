@@ -1,0 +1,118 @@
+/* Probe, not part of the build: VLP-16 scans a second in a dynamic map, the
+ * UV sphere as the scene's own mesh with INSTANCES boxes instanced into it
+ * (`rangecast bench` has no instances). Rays of a scene with instances go
+ * one by one through the top-level tree; on maps larger than the cache the
+ * built-in backend orders them (docs/benchmarks.md, session 20). Prints the
+ * best of three timed calls of POSES poses and a checksum of the ranges, to
+ * compare builds. Uses the public API only.
+ *
+ *   gcc -O2 -std=c99 -Iinclude -Itools/common tools/probes/instanced_map.c \
+ *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
+ *       [-lembree3] [-lvulkan] -o /tmp/instanced_map
+ *   /tmp/instanced_map THREADS BACKEND TRIANGLES [POSES [INSTANCES]]   (BACKEND: 1 bvh, 2 embree)
+ */
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+
+#include "meshgen.h"
+#include "rangecast/rangecast.h"
+
+static double now_s(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
+}
+
+static int fail(const rc_context *ctx, const char *what)
+{
+    fprintf(stderr, "%s: %s\n", what, ctx ? rc_context_last_error(ctx) : "failed");
+    return 1;
+}
+
+static rc_status add_mesh(rc_scene *scene, const rcu_mesh *m)
+{
+    rc_mesh_desc md = rc_mesh_desc_default();
+    uint32_t id;
+    md.vertices = m->vertices;
+    md.vertex_count = m->vertex_count;
+    md.indices = m->indices;
+    md.triangle_count = m->triangle_count;
+    md.flags = RC_MESH_REFERENCE;
+    return rc_scene_add_mesh(scene, &md, &id);
+}
+
+int main(int argc, char **argv)
+{
+    const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
+    rc_context_desc cd = rc_context_desc_default();
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_results res = rc_results_default();
+    rc_context *ctx = NULL;
+    rc_scene *box = NULL, *world = NULL;
+    rc_sensor *sensor = NULL;
+    rcu_mesh sphere, cube;
+    rc_pose *poses;
+    float *ranges;
+    uint32_t poses_n, insts, i, id, rays = 16u * 1800u;
+    double best = 1e30, sum = 0.0;
+    int rep;
+    if (argc < 4) {
+        fprintf(stderr, "usage: %s THREADS BACKEND TRIANGLES [POSES [INSTANCES]]\n", argv[0]);
+        return 2;
+    }
+    cd.thread_count = (uint32_t)atoi(argv[1]);
+    cd.backend = (uint32_t)atoi(argv[2]);
+    poses_n = argc > 4 ? (uint32_t)atoi(argv[4]) : 200u;
+    insts = argc > 5 ? (uint32_t)atoi(argv[5]) : 10u;
+    cd.memory_size = (size_t)1536 << 20; /* a 10M map, and the calls' ordering scratch */
+    if (rcu_mesh_uv_sphere_triangles(20.0f, strtoull(argv[3], NULL, 10), &sphere) != 0 ||
+        rcu_mesh_box(lo, hi, &cube) != 0)
+        return fail(NULL, "meshes");
+    if (rc_context_create(&cd, &ctx) != RC_OK) return fail(NULL, "rc_context_create");
+    sd.max_triangles = cube.triangle_count;
+    if (rc_scene_create(ctx, &sd, &box) != RC_OK || add_mesh(box, &cube) != RC_OK || rc_scene_commit(box) != RC_OK)
+        return fail(ctx, "box scene");
+    sd.max_triangles = sphere.triangle_count;
+    sd.max_instances = insts;
+    if (rc_scene_create(ctx, &sd, &world) != RC_OK || add_mesh(world, &sphere) != RC_OK) return fail(ctx, "map");
+    for (i = 0; i < insts; ++i) {
+        rc_instance_desc in = rc_instance_desc_default();
+        in.source = box;
+        in.transform = rc_pose_identity();
+        in.transform.position[0] = 3.0f + (float)i;
+        in.transform.position[1] = (float)(i % 3u) - 1.0f;
+        if (rc_scene_add_instance(world, &in, &id) != RC_OK) return fail(ctx, "instance");
+    }
+    if (rc_scene_commit(world) != RC_OK) return fail(ctx, "commit");
+    if (rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &sensor) != RC_OK) return fail(ctx, "sensor");
+    poses = (rc_pose *)malloc(sizeof *poses * poses_n);
+    ranges = (float *)malloc(sizeof *ranges * rays * (size_t)poses_n);
+    if (!poses || !ranges) return fail(NULL, "memory");
+    for (i = 0; i < poses_n; ++i) {
+        poses[i] = rc_pose_identity();
+        poses[i].position[0] = -5.0f + 10.0f * (float)i / (float)poses_n;
+        poses[i].position[1] = 2.0f * sinf((float)i);
+    }
+    res.attributes = RC_ATTR_RANGES;
+    res.ranges = ranges;
+    res.capacity = (uint64_t)rays * poses_n;
+    for (rep = 0; rep < 4; ++rep) { /* the first call warms up */
+        const double t0 = now_s();
+        if (rc_simulate(ctx, world, sensor, poses, poses_n, &res) != RC_OK) return fail(ctx, "rc_simulate");
+        if (rep && now_s() - t0 < best) best = now_s() - t0;
+    }
+    for (i = 0; i < rays * poses_n; i += 997u)
+        if (isfinite(ranges[i])) sum += ranges[i];
+    printf("%u triangles, %u instances, %u threads: %.1f scans/s (best of 3), range checksum %.6f\n",
+           sphere.triangle_count, insts, cd.thread_count, poses_n / best, sum);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&cube);
+    free(poses);
+    free(ranges);
+    return 0;
+}
