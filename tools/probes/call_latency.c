@@ -9,40 +9,22 @@
  *       [-lembree3] [-lvulkan] -o /tmp/call_latency
  *   /tmp/call_latency THREADS BACKEND RAYS [TRIANGLES]   (BACKEND: 1 bvh, 2 embree)
  */
-#define _POSIX_C_SOURCE 200809L
+#include "probe.h" /* first: it asks for POSIX */
+
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
-
-#include "meshgen.h"
-#include "rangecast/rangecast.h"
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
-static int fail(const rc_context *ctx, const char *what)
-{
-    fprintf(stderr, "%s: %s\n", what, ctx ? rc_context_last_error(ctx) : "failed");
-    return 1;
-}
 
 int main(int argc, char **argv)
 {
     rc_context_desc cd = rc_context_desc_default();
     rc_scene_desc sd = rc_scene_desc_default();
-    rc_mesh_desc md = rc_mesh_desc_default();
     rc_results res = rc_results_default();
     rc_pose pose = rc_pose_identity();
     rc_context *ctx = NULL;
     rc_scene *scene = NULL;
     rc_sensor *sensor = NULL;
     rcu_mesh mesh;
-    uint32_t rays, geom, i;
+    uint32_t rays, i;
     unsigned long long tris;
     float *ranges;
     double t0, t;
@@ -58,11 +40,7 @@ int main(int argc, char **argv)
     if (rcu_mesh_uv_sphere_triangles(20.0f, tris, &mesh) != 0) return fail(NULL, "sphere");
     if (rc_context_create(&cd, &ctx) != RC_OK) return fail(NULL, "rc_context_create");
     sd.max_triangles = mesh.triangle_count;
-    md.vertices = mesh.vertices;
-    md.vertex_count = mesh.vertex_count;
-    md.indices = mesh.indices;
-    md.triangle_count = mesh.triangle_count;
-    if (rc_scene_create(ctx, &sd, &scene) != RC_OK || rc_scene_add_mesh(scene, &md, &geom) != RC_OK ||
+    if (rc_scene_create(ctx, &sd, &scene) != RC_OK || probe_add_mesh(scene, &mesh, 0) != RC_OK ||
         rc_scene_commit(scene) != RC_OK)
         return fail(ctx, "scene");
     if (rays == 0) {

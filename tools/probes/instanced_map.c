@@ -11,39 +11,10 @@
  *       [-lembree3] [-lvulkan] -o /tmp/instanced_map
  *   /tmp/instanced_map THREADS BACKEND TRIANGLES [POSES [INSTANCES]]   (BACKEND: 1 bvh, 2 embree)
  */
-#define _POSIX_C_SOURCE 200809L
+#include "probe.h" /* first: it asks for POSIX */
+
 #include <math.h>
-#include <stdio.h>
 #include <stdlib.h>
-#include <time.h>
-
-#include "meshgen.h"
-#include "rangecast/rangecast.h"
-
-static double now_s(void)
-{
-    struct timespec t;
-    clock_gettime(CLOCK_MONOTONIC, &t);
-    return (double)t.tv_sec + (double)t.tv_nsec * 1e-9;
-}
-
-static int fail(const rc_context *ctx, const char *what)
-{
-    fprintf(stderr, "%s: %s\n", what, ctx ? rc_context_last_error(ctx) : "failed");
-    return 1;
-}
-
-static rc_status add_mesh(rc_scene *scene, const rcu_mesh *m)
-{
-    rc_mesh_desc md = rc_mesh_desc_default();
-    uint32_t id;
-    md.vertices = m->vertices;
-    md.vertex_count = m->vertex_count;
-    md.indices = m->indices;
-    md.triangle_count = m->triangle_count;
-    md.flags = RC_MESH_REFERENCE;
-    return rc_scene_add_mesh(scene, &md, &id);
-}
 
 int main(int argc, char **argv)
 {
@@ -74,11 +45,11 @@ int main(int argc, char **argv)
         return fail(NULL, "meshes");
     if (rc_context_create(&cd, &ctx) != RC_OK) return fail(NULL, "rc_context_create");
     sd.max_triangles = cube.triangle_count;
-    if (rc_scene_create(ctx, &sd, &box) != RC_OK || add_mesh(box, &cube) != RC_OK || rc_scene_commit(box) != RC_OK)
+    if (rc_scene_create(ctx, &sd, &box) != RC_OK || probe_add_mesh(box, &cube, RC_MESH_REFERENCE) != RC_OK || rc_scene_commit(box) != RC_OK)
         return fail(ctx, "box scene");
     sd.max_triangles = sphere.triangle_count;
     sd.max_instances = insts;
-    if (rc_scene_create(ctx, &sd, &world) != RC_OK || add_mesh(world, &sphere) != RC_OK) return fail(ctx, "map");
+    if (rc_scene_create(ctx, &sd, &world) != RC_OK || probe_add_mesh(world, &sphere, RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "map");
     for (i = 0; i < insts; ++i) {
         rc_instance_desc in = rc_instance_desc_default();
         in.source = box;
