@@ -2,9 +2,10 @@
  * single-ray search of the whole scene (rc__scene_intersect): packets mesh by
  * mesh on a scene of several meshes (duplicate meshes make every hit on them
  * a tie the lower geometry id must win), packets and OnDn single rays taking
- * turns on a map above the large-mesh threshold, each on 1 and 2 threads,
- * two poses, partial tile groups. Every ray must report the same triangle and
- * geometry. (test_packet.c and test_wide.c check the traversals bit for bit;
+ * turns on a map above the large-mesh threshold, and both again with two
+ * instances searched after them, each on 1 and 2 threads, two poses, partial
+ * tile groups. Every ray must report the same triangle, geometry and
+ * instance. (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
  * context's threshold is set by the test, whatever this CPU's cache. */
 #include <math.h>
@@ -29,7 +30,8 @@ static double uniform(void) { return rcu_rng_uniform(&rng); }
  * rotation: the world ray is the sensor ray moved by p): the hit's triangle
  * (returned) and geometry, or RC_INVALID_ID twice (also for a surface nearer
  * than range_min, which reads as no valid return). */
-static uint32_t expected_prim(const rc_scene *scene, const rc_sensor *s, uint32_t i, const rc_pose *p, uint32_t *geom)
+static uint32_t expected_prim(const rc_scene *scene, const rc_sensor *s, uint32_t i, const rc_pose *p, uint32_t *geom,
+                              uint32_t *inst)
 {
     float org[3], dir[3];
     rc__ray r;
@@ -43,11 +45,10 @@ static uint32_t expected_prim(const rc_scene *scene, const rc_sensor *s, uint32_
     h.t = RANGE_MAX;
     h.u = h.v = 0.0f;
     h.prim = h.geom = h.inst = h.slot = RC_INVALID_ID;
-    if (!rc__scene_intersect(scene, &r, &h) || h.t < RANGE_MIN) {
-        *geom = RC_INVALID_ID;
-        return RC_INVALID_ID;
-    }
+    *geom = *inst = RC_INVALID_ID;
+    if (!rc__scene_intersect(scene, &r, &h) || h.t < RANGE_MIN) return RC_INVALID_ID;
     *geom = h.geom;
+    *inst = h.inst;
     return h.prim;
 }
 
@@ -55,38 +56,72 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
 {
     rc_pose poses[POSES];
     rct_buffers buf;
-    uint32_t p, i, hits = 0, box_hits = 0;
+    uint32_t p, i, hits = 0, box_hits = 0, inst_hits = 0;
     poses[0] = rct_pose(0.0f, 0.0f, 0.0f);
     poses[1] = rct_pose(3.0f, -2.0f, 1.0f);
-    rct_buffers_alloc(&buf, (uint64_t)POSES * rays, RC_ATTR_HITS | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS);
+    rct_buffers_alloc(&buf, (uint64_t)POSES * rays, RC_ATTR_HITS | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS);
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, POSES, &buf.res));
     for (p = 0; p < POSES; ++p)
         for (i = 0; i < rays; ++i) {
             const uint64_t at = (uint64_t)p * rays + i;
-            uint32_t want_geom;
-            const uint32_t want = expected_prim(scene, sensor, i, &poses[p], &want_geom);
+            uint32_t want_geom, want_inst;
+            const uint32_t want = expected_prim(scene, sensor, i, &poses[p], &want_geom, &want_inst);
             assert_int_equal(buf.res.prim_ids[at], want);
             assert_int_equal(buf.res.geom_ids[at], want_geom);
+            assert_int_equal(buf.res.inst_ids[at], want_inst);
+            inst_hits += want_inst != RC_INVALID_ID;
             assert_int_equal(buf.res.hits[at], want != RC_INVALID_ID);
             hits += buf.res.hits[at];
-            box_hits += want_geom == 1u;
+            box_hits += want_geom == 1u && want_inst == RC_INVALID_ID;
         }
     /* every origin is inside the closed sphere (an OnDn origin may sit just
      * on a box); with the boxes in the scene, some rays end on them (on
      * geometry 1, never on its duplicate) */
     assert_true(hits + 2u >= POSES * rays);
-    if (scene->geom_count > 1) assert_true(box_hits > 0);
+    if (scene->geom_count > 1 && scene->inst_count == 0) assert_true(box_hits > 0);
+    if (scene->inst_count > 0) assert_true(inst_hits > 0);
     rct_buffers_free(&buf);
 }
 
-/* A scene of the sphere and, with boxes set, a box (geometry 1) and the
- * same box again (geometry 2), all referenced. */
-static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes)
+/* A scene of the sphere and, with boxes 1, a box (geometry 1) and the same
+ * box again (geometry 2), all referenced; with boxes 2 also two instances of
+ * a scene of the box, one where the own box is (hits there tie between
+ * geometry 1 and instance 0, which the instance wins: the tie rule orders
+ * by instance id first, and own meshes have none) and one turned beside it
+ * (*src holds that scene). */
+static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes, rc_scene **src)
 {
     const rcu_mesh *parts[3];
+    rc_scene *scene;
+    uint32_t i, id;
     parts[0] = sphere;
     parts[1] = parts[2] = box;
-    return rct_scene_meshes(ctx, parts, boxes ? 3u : 1u);
+    *src = NULL;
+    if (boxes < 2) return rct_scene_meshes(ctx, parts, boxes ? 3u : 1u);
+    {
+        rc_scene_desc sd = rc_scene_desc_default();
+        *src = rct_scene_meshes(ctx, &box, 1u);
+        sd.max_geometries = 3;
+        sd.max_triangles = sphere->triangle_count + 2u * box->triangle_count;
+        sd.max_instances = 2;
+        RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+        for (i = 0; i < 3u; ++i) {
+            rc_mesh_desc md = rc_mesh_desc_default();
+            md.vertices = parts[i]->vertices;
+            md.vertex_count = parts[i]->vertex_count;
+            md.indices = parts[i]->indices;
+            md.triangle_count = parts[i]->triangle_count;
+            RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+        }
+        for (i = 0; i < 2u; ++i) {
+            rc_instance_desc in = rc_instance_desc_default();
+            in.source = *src;
+            in.transform = i ? rct_pose_ypr(-9.0f, 3.0f, 0.0f, 0.7, 0.0, 0.2) : rct_pose(0.0f, 0.0f, 0.0f);
+            RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
+        }
+        RCT_OK(ctx, rc_scene_commit(scene));
+    }
+    return scene;
 }
 
 static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,
@@ -95,12 +130,12 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
     uint32_t threads;
     for (threads = 1; threads <= 2; ++threads) {
         rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 128);
-        rc_scene *scene;
+        rc_scene *scene, *src;
         rc_rays_desc d = rc_rays_desc_default();
         rc_sensor *o1dn, *ondn = NULL;
         assert_true(ctx->large_mesh_bytes >= RC__LARGE_MESH_BYTES);
         ctx->large_mesh_bytes = large_bytes;
-        scene = make_scene(ctx, sphere, box, boxes);
+        scene = make_scene(ctx, sphere, box, boxes, &src);
         assert_int_equal(rc__mesh_is_large(&scene->geoms[0].mesh, large_bytes), large_bytes == RC__LARGE_MESH_BYTES);
         o1dn = rct_sensor_dirs(ctx, dirs, rays, RANGE_MIN, RANGE_MAX);
         d.common.range_min = RANGE_MIN;
@@ -113,6 +148,8 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
         check_sensor(ctx, scene, ondn, rays);
         rc_sensor_destroy(o1dn);
         rc_sensor_destroy(ondn);
+        rc_scene_destroy(scene);
+        if (src) rc_scene_destroy(src);
         rc_context_destroy(ctx);
     }
 }
@@ -145,6 +182,9 @@ static void test_simulate_paths(void **state)
     run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 0, dirs, orgs, rays);
     run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 1, dirs, orgs, rays);
     run_paths(&sphere, &box, UINT64_MAX, 1, dirs, orgs, rays);
+    /* instances after packets and runs, taking turns or not */
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 2, dirs, orgs, rays);
+    run_paths(&sphere, &box, UINT64_MAX, 2, dirs, orgs, rays);
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&box);
     free(dirs);

@@ -96,9 +96,15 @@ rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_
 /* 1 when every instance's source is committed at the version seen at our commit. */
 int rc__scene_up_to_date(const rc_scene *scene);
 
-/* Nearest hit in the scene along ray (scene coordinates), 0 < t < hit->t.
- * Returns 1 when hit was updated. */
-int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit);
+/* Nearest hit in the scene along ray (scene coordinates), 0 < t < hit->t,
+ * among the top level's items from first on (0: everything; geom_count: the
+ * instances only, after the own meshes were searched another way). Returns 1
+ * when hit was updated. */
+int rc__scene_intersect_items(const rc_scene *scene, const rc__ray *ray, rc__hit *hit, uint32_t first);
+static inline int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
+{
+    return rc__scene_intersect_items(scene, ray, hit, 0u);
+}
 
 /* The hit's distance recomputed in double: the ray (sensor-frame direction
  * dir_s and origin org_s, NULL for the sensor's own origin, through the

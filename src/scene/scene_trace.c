@@ -48,7 +48,7 @@ static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc
     return found;
 }
 
-int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
+int rc__scene_intersect_items(const rc_scene *scene, const rc__ray *ray, rc__hit *hit, uint32_t first)
 {
     uint32_t stack[RC__BVH_MAX_DEPTH + 1];
     uint32_t sp = 0, ni = 0;
@@ -70,6 +70,7 @@ int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray, rc__hit *hit)
                 uint32_t k;
                 for (k = 0; k < n->count; ++k) {
                     uint32_t item = top->refs[n->index + k];
+                    if (item < first) continue;
                     if (item < scene->geom_count)
                         found |= rc__mesh_intersect(&scene->geoms[item].mesh, ray, item, RC_INVALID_ID, hit);
                     else

@@ -9,7 +9,9 @@
  *   gcc -O2 -std=c99 -Iinclude -Itools/common tools/probes/instanced_map.c \
  *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
  *       [-lembree3] [-lvulkan] -o /tmp/instanced_map
- *   /tmp/instanced_map THREADS BACKEND TRIANGLES [POSES [INSTANCES]]   (BACKEND: 1 bvh, 2 embree)
+ *   /tmp/instanced_map THREADS BACKEND TRIANGLES [POSES [INSTANCES [SPREAD]]]   (BACKEND: 1 bvh, 2 embree)
+ * SPREAD 0 (default): poses along a line, turned alike; 1: random positions
+ * within 6 m of the centre and random headings, as `rangecast bench` draws.
  */
 #include "probe.h" /* first: it asks for POSIX */
 
@@ -28,7 +30,7 @@ int main(int argc, char **argv)
     rcu_mesh sphere, cube;
     rc_pose *poses;
     float *ranges;
-    uint32_t poses_n, insts, i, id, rays = 16u * 1800u;
+    uint32_t poses_n, insts, spread, i, id, rays = 16u * 1800u;
     double best = 1e30, sum = 0.0;
     int rep;
     if (argc < 4) {
@@ -39,6 +41,7 @@ int main(int argc, char **argv)
     cd.backend = (uint32_t)atoi(argv[2]);
     poses_n = argc > 4 ? (uint32_t)atoi(argv[4]) : 200u;
     insts = argc > 5 ? (uint32_t)atoi(argv[5]) : 10u;
+    spread = argc > 6 ? (uint32_t)atoi(argv[6]) : 0u;
     cd.memory_size = (size_t)1536 << 20; /* a 10M map, and the calls' ordering scratch */
     if (rcu_mesh_uv_sphere_triangles(20.0f, strtoull(argv[3], NULL, 10), &sphere) != 0 ||
         rcu_mesh_box(lo, hi, &cube) != 0)
@@ -63,10 +66,20 @@ int main(int argc, char **argv)
     poses = (rc_pose *)malloc(sizeof *poses * poses_n);
     ranges = (float *)malloc(sizeof *ranges * rays * (size_t)poses_n);
     if (!poses || !ranges) return fail(NULL, "memory");
+    srand(1);
     for (i = 0; i < poses_n; ++i) {
         poses[i] = rc_pose_identity();
-        poses[i].position[0] = -5.0f + 10.0f * (float)i / (float)poses_n;
-        poses[i].position[1] = 2.0f * sinf((float)i);
+        if (spread) {
+            const double yaw = 6.283185307179586 * rand() / RAND_MAX;
+            poses[i].position[0] = (float)(12.0 * rand() / RAND_MAX - 6.0);
+            poses[i].position[1] = (float)(12.0 * rand() / RAND_MAX - 6.0);
+            poses[i].position[2] = (float)(4.0 * rand() / RAND_MAX - 2.0);
+            poses[i].orientation[2] = (float)sin(yaw / 2.0); /* about z: (x, y, z, w) */
+            poses[i].orientation[3] = (float)cos(yaw / 2.0);
+        } else {
+            poses[i].position[0] = -5.0f + 10.0f * (float)i / (float)poses_n;
+            poses[i].position[1] = 2.0f * sinf((float)i);
+        }
     }
     res.attributes = RC_ATTR_RANGES;
     res.ranges = ranges;
