@@ -250,30 +250,14 @@ static void test_occupancy_key(void **state)
 static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, rc_scene **src)
 {
     const rcu_mesh *parts[2];
-    rc_scene_desc sd = rc_scene_desc_default();
-    rc_mesh_desc md = rc_mesh_desc_default();
-    rc_scene *scene;
-    uint32_t i, id;
+    rc_pose at[2];
     parts[0] = box ? box : sphere;
     parts[1] = sphere;
     if (!src) return rct_scene_meshes(ctx, parts, box ? 2u : 1u);
     *src = rct_scene_meshes(ctx, &box, 1u);
-    sd.max_triangles = sphere->triangle_count;
-    sd.max_instances = 2;
-    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
-    md.vertices = sphere->vertices;
-    md.vertex_count = sphere->vertex_count;
-    md.indices = sphere->indices;
-    md.triangle_count = sphere->triangle_count;
-    RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
-    for (i = 0; i < 2u; ++i) {
-        rc_instance_desc in = rc_instance_desc_default();
-        in.source = *src;
-        in.transform = rct_pose_ypr(i ? -9.0f : 0.0f, i ? 4.0f : 0.0f, 0.0f, 0.4 * i, 0.0, 0.1);
-        RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
-    }
-    RCT_OK(ctx, rc_scene_commit(scene));
-    return scene;
+    at[0] = rct_pose_ypr(0.0f, 0.0f, 0.0f, 0.0, 0.0, 0.1);
+    at[1] = rct_pose_ypr(-9.0f, 4.0f, 0.0f, 0.4, 0.0, 0.1);
+    return rct_scene_instanced(ctx, &sphere, 1u, *src, at, 2u);
 }
 
 /* Simulates the sensor at POSES poses into buf; returns the arena bytes the

@@ -92,36 +92,15 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
 static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes, rc_scene **src)
 {
     const rcu_mesh *parts[3];
-    rc_scene *scene;
-    uint32_t i, id;
+    rc_pose at[2];
     parts[0] = sphere;
     parts[1] = parts[2] = box;
     *src = NULL;
     if (boxes < 2) return rct_scene_meshes(ctx, parts, boxes ? 3u : 1u);
-    {
-        rc_scene_desc sd = rc_scene_desc_default();
-        *src = rct_scene_meshes(ctx, &box, 1u);
-        sd.max_geometries = 3;
-        sd.max_triangles = sphere->triangle_count + 2u * box->triangle_count;
-        sd.max_instances = 2;
-        RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
-        for (i = 0; i < 3u; ++i) {
-            rc_mesh_desc md = rc_mesh_desc_default();
-            md.vertices = parts[i]->vertices;
-            md.vertex_count = parts[i]->vertex_count;
-            md.indices = parts[i]->indices;
-            md.triangle_count = parts[i]->triangle_count;
-            RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
-        }
-        for (i = 0; i < 2u; ++i) {
-            rc_instance_desc in = rc_instance_desc_default();
-            in.source = *src;
-            in.transform = i ? rct_pose_ypr(-9.0f, 3.0f, 0.0f, 0.7, 0.0, 0.2) : rct_pose(0.0f, 0.0f, 0.0f);
-            RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
-        }
-        RCT_OK(ctx, rc_scene_commit(scene));
-    }
-    return scene;
+    *src = rct_scene_meshes(ctx, &box, 1u);
+    at[0] = rct_pose(0.0f, 0.0f, 0.0f);
+    at[1] = rct_pose_ypr(-9.0f, 3.0f, 0.0f, 0.7, 0.0, 0.2);
+    return rct_scene_instanced(ctx, parts, 3u, *src, at, 2u);
 }
 
 static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,

@@ -175,11 +175,18 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags)
 
 rc_scene *rct_scene_meshes(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count)
 {
+    return rct_scene_instanced(ctx, meshes, count, NULL, NULL, 0);
+}
+
+rc_scene *rct_scene_instanced(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count, const rc_scene *src,
+                              const rc_pose *transforms, uint32_t inst_count)
+{
     rc_scene_desc sd = rc_scene_desc_default();
     rc_scene *scene = NULL;
     uint32_t g, id;
     sd.max_geometries = count;
     sd.max_triangles = 0;
+    sd.max_instances = inst_count;
     for (g = 0; g < count; ++g) sd.max_triangles += meshes[g]->triangle_count;
     RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
     for (g = 0; g < count; ++g) {
@@ -189,6 +196,13 @@ rc_scene *rct_scene_meshes(rc_context *ctx, const rcu_mesh *const *meshes, uint3
         md.indices = meshes[g]->indices;
         md.triangle_count = meshes[g]->triangle_count;
         RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+        assert_int_equal(id, g);
+    }
+    for (g = 0; g < inst_count; ++g) {
+        rc_instance_desc in = rc_instance_desc_default();
+        in.source = src;
+        in.transform = transforms[g];
+        RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
         assert_int_equal(id, g);
     }
     RCT_OK(ctx, rc_scene_commit(scene));

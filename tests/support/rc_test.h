@@ -35,6 +35,10 @@ rc_scene *rct_scene_mesh(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags);
 /* The same, built with build_quality (RC_BUILD_*), not yet committed. */
 /* A committed scene of count referenced meshes; mesh g gets geometry id g. */
 rc_scene *rct_scene_meshes(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count);
+/* The same with inst_count instances of the committed scene src, instance i
+ * placed by transforms[i]. */
+rc_scene *rct_scene_instanced(rc_context *ctx, const rcu_mesh *const *meshes, uint32_t count, const rc_scene *src,
+                              const rc_pose *transforms, uint32_t inst_count);
 rc_scene *rct_scene_uncommitted(rc_context *ctx, const rcu_mesh *mesh, uint32_t flags, uint32_t build_quality);
 
 /* rc_context_desc.backend_budget_mib on a backend that allocates outside the
