@@ -557,6 +557,9 @@ bool trace_mesh(Ray r, Slab s, uint gi, uint geom_id, uint inst, inout Hit h)
                 cnt = lane_u(count, bl);
                 continue;
             }
+            /* a dead end pops here, inside the node loop, so that the lane
+             * walks on with the others instead of waiting out their leaves;
+             * the pop after the leaves below is the same code on purpose */
             alive = false;
             while (sp > 0u && !alive) {
                 --sp;

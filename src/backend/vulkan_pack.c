@@ -170,6 +170,7 @@ static void fill_mesh(const rc__mesh *m, uint32_t geom_id, uint64_t wide, const 
                 w->box[2u * k + 1u][i] = -INFINITY;
             }
             w->child[i] = RC__WIDE_EMPTY;
+            w->count[i] = 0;
         }
     }
     if (out == dst->wide_scratch) span_write(&dst->nodes, c->node, out, WIDE_SLOTS * wide);
