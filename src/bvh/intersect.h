@@ -41,8 +41,9 @@
  * in a case fuzz_trace found, where the same triangle in an instance lay in a
  * box whose entry rounded above it). 32 ulps keep such a box, so a tie
  * between meshes or instances goes by the key whatever the order they are
- * searched in (a triangle seen edge-on can round further than any fixed
- * slack); it cost 0.014% more instructions (docs/benchmarks.md). */
+ * searched in (a triangle seen edge-on, or reaching far beyond its hit point
+ * along the ray, can round further than any fixed slack: docs/architecture.md,
+ * "The BVH"); it cost 0.014% more instructions (docs/benchmarks.md). */
 #define RC__SLAB_FAR_SCALE (1.0f + 32.0f * FLT_EPSILON)
 
 /* Per-ray constants of the slab test. A node is read as it is laid out
