@@ -12,6 +12,7 @@
 
 #include "bvh/intersect.h"
 #include "bvh/leaf4.h"
+#include "bvh/wide_box.h"
 #include "core/common.h"
 
 #include <float.h>
@@ -196,6 +197,55 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     }
     return out;
 #endif
+}
+
+/* A packet whose live lanes have thinned out (deep in the tree on large maps
+ * every ray hits its own triangle) tests them one by one: FEW_LANES single-ray
+ * tests of all four boxes cost less than one packet test of each box over
+ * every lane (1M-triangle sphere: +10% scans/s; 10M: +22%). */
+#define FEW_LANES 4u
+
+/* Index of the lowest set bit (mask != 0). Live lanes lie anywhere in the
+ * mask, so a loop shifting to the next one would mispredict. */
+static RC__FORCE_INLINE uint32_t lowest_lane(uint32_t mask)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctz(mask);
+#else
+    uint32_t lane = 0;
+    while (!((mask >> lane) & 1u)) ++lane;
+    return lane;
+#endif
+}
+
+/* The lanes of mask (at most FEW_LANES), each against the four children of
+ * n: met[c] gets the lanes that meet child c, the same bits box_mask gives
+ * (the same operations in the same order), tn[c] the nearest entry distance
+ * (ordering only). Returns the children some lane meets. */
+static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, uint32_t mask,
+                                              uint32_t met[4], float tn[4])
+{
+    uint32_t any = 0, c;
+    int first = 1;
+    while (mask) {
+        const uint32_t lane = lowest_lane(mask);
+        float inv[3], tl[4] RC__ALIGN16;
+        uint32_t h;
+        mask &= mask - 1u;
+        inv[0] = L->ix[lane];
+        inv[1] = L->iy[lane];
+        inv[2] = L->iz[lane];
+        /* the first lane's entry distances go straight to tn (a select
+         * there, on a flag, measured as a mispredicted branch per child) */
+        h = rc__wide_box_test(n, L->near_row, L->org, inv, L->tmax[lane], first ? tn : tl);
+        any |= h;
+        for (c = 0; c < 4; ++c) {
+            met[c] |= ((h >> c) & 1u) << lane;
+            if (!first) tn[c] = tl[c] < tn[c] ? tl[c] : tn[c];
+        }
+        first = 0;
+    }
+    return any;
 }
 
 /* L->tmax[lane] = t, written as the whole row of four lanes: the box tests
@@ -444,11 +494,20 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         const rc__wnode *nd = &nodes[child];
         packet_entry e[4];
         float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
-        uint32_t m = 0, c, j, maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
+        uint32_t lanes_met[4] = {0u, 0u, 0u, 0u};
+        uint32_t m = 0, c, j, maybe, few = mask;
+        for (j = 0; j < FEW_LANES; ++j) few &= few - 1u;
+        if (few == 0) {
+            /* at most FEW_LANES live lanes: each meets the four boxes at once
+             * (the single-ray test), cheaper than every box over all lanes */
+            maybe = few_lanes_met(nd, L, mask, lanes_met, tn);
+        } else {
+            maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
+        }
         for (c = 0; c < 4; ++c) {
             uint32_t mc;
             if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
-            mc = box_mask(nd, c, L, mask);
+            mc = few == 0 ? lanes_met[c] : box_mask(nd, c, L, mask);
             if (!mc) continue;
             e[m].child = nd->child[c];
             e[m].count = nd->count[c];

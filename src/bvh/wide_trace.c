@@ -12,16 +12,8 @@
 
 #include "bvh/intersect.h"
 #include "bvh/leaf4.h"
+#include "bvh/wide_box.h"
 #include "core/common.h"
-
-#if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
-#include <emmintrin.h>
-#define RC__WIDE_SSE2 1
-#elif defined(__ARM_NEON) && !defined(RC__WIDE_FORCE_SCALAR)
-#include <arm_neon.h>
-#define RC__WIDE_NEON 1
-#endif
-
 
 /* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
 #define STACK_SIZE (3u * RC__BVH_MAX_DEPTH + 4u)
@@ -67,66 +59,7 @@ static RC__FORCE_INLINE uint32_t lowest_bit(uint32_t mask)
  * (conservatively, Ize's bound); tn[c] gets the entry distance. */
 static RC__FORCE_INLINE uint32_t wide_box_test(const rc__wnode *n, const wide_ray *w, float tmax, float tn[4])
 {
-    const float *nx = n->box[w->near_row[0]], *fx = n->box[w->near_row[0] ^ 1u];
-    const float *ny = n->box[w->near_row[1]], *fy = n->box[w->near_row[1] ^ 1u];
-    const float *nz = n->box[w->near_row[2]], *fz = n->box[w->near_row[2] ^ 1u];
-#if defined(RC__WIDE_SSE2)
-    const __m128 ox = _mm_set1_ps(w->org[0]), oy = _mm_set1_ps(w->org[1]), oz = _mm_set1_ps(w->org[2]);
-    const __m128 ix = _mm_set1_ps(w->inv[0]), iy = _mm_set1_ps(w->inv[1]), iz = _mm_set1_ps(w->inv[2]);
-    /* max/min return the second operand when the first is NaN (0 * inf: the
-     * origin on a plane of a parallel ray): such a plane imposes nothing */
-    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nx), ox), ix), _mm_setzero_ps());
-    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fx), ox), ix), _mm_set1_ps(tmax));
-    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ny), oy), iy), t0);
-    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fy), oy), iy), t1);
-    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nz), oz), iz), t0);
-    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fz), oz), iz), t1);
-    _mm_store_ps(tn, t0);
-    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
-#elif defined(RC__WIDE_NEON)
-    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
-    const float32x4_t ox = vdupq_n_f32(w->org[0]), oy = vdupq_n_f32(w->org[1]), oz = vdupq_n_f32(w->org[2]);
-    const float32x4_t ix = vdupq_n_f32(w->inv[0]), iy = vdupq_n_f32(w->inv[1]), iz = vdupq_n_f32(w->inv[2]);
-    float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(tmax), a;
-    uint32x4_t h;
-    uint32x2_t s2;
-    /* "a > b ? a : b" (NEON's max would let a NaN through) */
-    a = vmulq_f32(vsubq_f32(vld1q_f32(nx), ox), ix);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(ny), oy), iy);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(nz), oz), iz);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fx), ox), ix);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fy), oy), iy);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fz), oz), iz);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-    vst1q_f32(tn, t0);
-    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
-    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
-    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
-#else
-    uint32_t mask = 0;
-    int c;
-    for (c = 0; c < 4; ++c) {
-        const float ax = (nx[c] - w->org[0]) * w->inv[0], ay = (ny[c] - w->org[1]) * w->inv[1];
-        const float az = (nz[c] - w->org[2]) * w->inv[2];
-        const float bx = (fx[c] - w->org[0]) * w->inv[0], by = (fy[c] - w->org[1]) * w->inv[1];
-        const float bz = (fz[c] - w->org[2]) * w->inv[2];
-        float t0 = 0.0f, t1 = tmax;
-        t0 = ax > t0 ? ax : t0;
-        t0 = ay > t0 ? ay : t0;
-        t0 = az > t0 ? az : t0;
-        t1 = bx < t1 ? bx : t1;
-        t1 = by < t1 ? by : t1;
-        t1 = bz < t1 ? bz : t1;
-        tn[c] = t0;
-        if (t0 <= t1 * RC__SLAB_FAR_SCALE) mask |= 1u << c;
-    }
-    return mask;
-#endif
+    return rc__wide_box_test(n, w->near_row, w->org, w->inv, tmax, tn);
 }
 
 /* Adds child c of n to e[0..m), kept nearest first; returns m + 1. */

@@ -1,0 +1,91 @@
+/* One ray against the four child boxes of a wide node (wide.h) at once: SSE2
+ * on x86-64, NEON on ARM, a plain loop elsewhere (or with
+ * RC__WIDE_FORCE_SCALAR, for tests and instruction counts). The single-ray
+ * traversal tests every node this way, and a packet does for each of its
+ * last few live lanes (packet.c). Each lane repeats the robust slab test of
+ * intersect.h, so every path culls exactly as conservatively. */
+#ifndef RC_BVH_WIDE_BOX_H
+#define RC_BVH_WIDE_BOX_H
+
+#include "bvh/intersect.h"
+#include "bvh/wide.h"
+
+#include <stdint.h>
+
+#if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
+#include <emmintrin.h>
+#define RC__WIDE_BOX_SSE2 1
+#elif defined(__ARM_NEON) && !defined(RC__WIDE_FORCE_SCALAR)
+#include <arm_neon.h>
+#define RC__WIDE_BOX_NEON 1
+#endif
+
+/* Bit c set when the ray from org with reciprocal direction inv meets child
+ * c's box within [0, tmax] (conservatively, Ize's bound); tn[c] gets the
+ * entry distance. near_row[k] is the plane row axis k enters by (wide.h). */
+static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uint32_t near_row[3], const float org[3],
+                                                   const float inv[3], float tmax, float tn[4])
+{
+    const float *nx = n->box[near_row[0]], *fx = n->box[near_row[0] ^ 1u];
+    const float *ny = n->box[near_row[1]], *fy = n->box[near_row[1] ^ 1u];
+    const float *nz = n->box[near_row[2]], *fz = n->box[near_row[2] ^ 1u];
+#if defined(RC__WIDE_BOX_SSE2)
+    const __m128 ox = _mm_set1_ps(org[0]), oy = _mm_set1_ps(org[1]), oz = _mm_set1_ps(org[2]);
+    const __m128 ix = _mm_set1_ps(inv[0]), iy = _mm_set1_ps(inv[1]), iz = _mm_set1_ps(inv[2]);
+    /* max/min return the second operand when the first is NaN (0 * inf: the
+     * origin on a plane of a parallel ray): such a plane imposes nothing */
+    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nx), ox), ix), _mm_setzero_ps());
+    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fx), ox), ix), _mm_set1_ps(tmax));
+    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ny), oy), iy), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fy), oy), iy), t1);
+    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nz), oz), iz), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fz), oz), iz), t1);
+    _mm_store_ps(tn, t0);
+    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
+#elif defined(RC__WIDE_BOX_NEON)
+    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
+    const float32x4_t ox = vdupq_n_f32(org[0]), oy = vdupq_n_f32(org[1]), oz = vdupq_n_f32(org[2]);
+    const float32x4_t ix = vdupq_n_f32(inv[0]), iy = vdupq_n_f32(inv[1]), iz = vdupq_n_f32(inv[2]);
+    float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(tmax), a;
+    uint32x4_t h;
+    uint32x2_t s2;
+    /* "a > b ? a : b" (NEON's max would let a NaN through) */
+    a = vmulq_f32(vsubq_f32(vld1q_f32(nx), ox), ix);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(ny), oy), iy);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(nz), oz), iz);
+    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fx), ox), ix);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fy), oy), iy);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    a = vmulq_f32(vsubq_f32(vld1q_f32(fz), oz), iz);
+    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    vst1q_f32(tn, t0);
+    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
+    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
+    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+#else
+    uint32_t mask = 0;
+    int c;
+    for (c = 0; c < 4; ++c) {
+        const float ax = (nx[c] - org[0]) * inv[0], ay = (ny[c] - org[1]) * inv[1];
+        const float az = (nz[c] - org[2]) * inv[2];
+        const float bx = (fx[c] - org[0]) * inv[0], by = (fy[c] - org[1]) * inv[1];
+        const float bz = (fz[c] - org[2]) * inv[2];
+        float t0 = 0.0f, t1 = tmax;
+        t0 = ax > t0 ? ax : t0;
+        t0 = ay > t0 ? ay : t0;
+        t0 = az > t0 ? az : t0;
+        t1 = bx < t1 ? bx : t1;
+        t1 = by < t1 ? by : t1;
+        t1 = bz < t1 ? bz : t1;
+        tn[c] = t0;
+        if (t0 <= t1 * RC__SLAB_FAR_SCALE) mask |= 1u << c;
+    }
+    return mask;
+#endif
+}
+
+#endif
