@@ -111,7 +111,13 @@ static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, flo
  * file includes this header without using it). */
 #if defined(__GNUC__)
 #define RC__COLD static __attribute__((noinline, unused))
+#if defined(__OPTIMIZE_SIZE__)
+/* -Os asks for size: the compiler decides (forcing every hot helper inline
+ * at each of its callers cost the aarch64 core 7.9 KB) */
+#define RC__FORCE_INLINE inline
+#else
 #define RC__FORCE_INLINE inline __attribute__((always_inline))
+#endif
 #define RC__ALIGN16 __attribute__((aligned(16)))
 #define RC__PREFETCH(p) __builtin_prefetch(p)
 #else
