@@ -546,15 +546,13 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         const float *vt[4][3];
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
         rc__leaf4_soa soa RC__ALIGN16;
-        uint32_t m = mask, lane = 0;
+        uint32_t m = mask;
         int shrunk = 0;
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
-        for (; m; ++lane, m >>= 1) {
+        while (m) {
+            const uint32_t lane = lowest_lane(m);
             uint32_t cand;
-            while (!(m & 1u)) {
-                ++lane;
-                m >>= 1;
-            }
+            m &= m - 1u;
             cand = rc__leaf4_candidates_soa(&rays[lane], &soa, n_tri);
             while (cand) {
                 uint32_t c = 0;
