@@ -37,7 +37,7 @@ typedef struct packet_entry {
     uint32_t child;
     uint32_t count; /* 0: a node; else a leaf's triangle count */
     uint32_t mask;  /* lanes that met its box when it was pushed */
-    float tmin;     /* the packet's entry bound (ordering only) */
+    float tmin;     /* its lanes' entry distances bound from below: orders children, drops pops */
 } packet_entry;
 
 /* Per-lane slab data, 16-byte aligned rows of 4 lanes. */
@@ -570,20 +570,26 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     }
     /* pop; lanes that have since found nearer hits drop out in the box tests
      * of the next turn (tmax per lane) */
-    if (T->sp == 0) {
-        uint32_t i;
-        if (interleaved) {
-            /* a prim id is a read from refs, a miss on a large map: prefetch
-             * them and settle in a turn of their own */
-            for (i = 0; i < T->n; ++i)
-                if (T->hits[i].prim == RC__PRIM_PENDING) RC__PREFETCH(mesh->bvh.refs + T->hits[i].slot);
-            T->settling = 1;
-            return 1;
+    do {
+        if (T->sp == 0) {
+            uint32_t i;
+            if (interleaved) {
+                /* a prim id is a read from refs, a miss on a large map:
+                 * prefetch them and settle in a turn of their own */
+                for (i = 0; i < T->n; ++i)
+                    if (T->hits[i].prim == RC__PRIM_PENDING) RC__PREFETCH(mesh->bvh.refs + T->hits[i].slot);
+                T->settling = 1;
+                return 1;
+            }
+            for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
+            return 0;
         }
-        for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
-        return 0;
-    }
-    --T->sp;
+        --T->sp;
+        /* an entry whose bound lies beyond every lane's nearest hit is
+         * dropped here, as its box tests would drop every lane (tmin bounds
+         * the entry distances of its lanes from below, P.tmax their tmax
+         * from above) */
+    } while (T->P.usable && T->stack[T->sp].tmin > T->P.tmax * RC__SLAB_FAR_SCALE);
     T->staged = 0;
     T->child = T->stack[T->sp].child;
     T->count = T->stack[T->sp].count;
