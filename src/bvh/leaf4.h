@@ -1,13 +1,13 @@
-/* A leaf's (up to) four triangles against one ray at once: the first half of
- * the watertight test (shear, edge functions, sign test) in SSE2 or NEON
- * lanes, as a filter. A lane whose three edge functions have mixed non-zero
- * signs is rejected here exactly as rc__tri_intersect would reject it: every
- * lane repeats the scalar test's operations in the same order (IEEE single
- * precision, no contraction), so its edge functions are the scalar ones bit
- * for bit. Every other lane (a possible hit, a zero edge function for the
- * double fallback, a NaN from overflow) goes to rc__tri_intersect, which
- * decides. Most triangles of a leaf are rejected here, four per few SIMD
- * instructions; the answer is the scalar test's by construction. */
+/* A leaf's (up to) four triangles against one ray at once: the watertight
+ * test (shear, edge functions, sign test, determinant, distance) in SSE2 or
+ * NEON lanes. Every lane repeats the scalar test's operations in the same
+ * order (IEEE single precision, no contraction), so a lane's edge functions,
+ * t and barycentrics are rc__tri_intersect's bit for bit, and a lane that
+ * test would reject is rejected here. Lanes that reach one of its rare
+ * double-precision cases (a zero edge function, a NaN from overflow, an
+ * origin in the triangle's plane) go to rc__tri_intersect, which decides.
+ * 32-bit ARM runs only the first half in lanes, as a filter (see
+ * RC__LEAF4_FULL). The answer is the scalar test's by construction. */
 #ifndef RC_BVH_LEAF4_H
 #define RC_BVH_LEAF4_H
 
@@ -63,7 +63,7 @@ static RC__FORCE_INLINE void rc__leaf4_prefetch_vertices(const float *const v[4]
     }
 }
 
-/* A leaf's (up to) four triangles transposed for the SIMD filter:
+/* A leaf's (up to) four triangles transposed for the SIMD test:
  * c[vertex][axis][slot], slots past the leaf's count repeating slot 0. A
  * packet transposes a leaf once and filters every live lane from it. */
 typedef struct rc__leaf4_soa {
@@ -94,6 +94,11 @@ typedef __m128 rc__v4mask;
 #define RC__V4_AND(a, b) _mm_and_ps(a, b)
 #define RC__V4_ORDERED(a, b) _mm_cmpord_ps(a, b)
 #define RC__V4_LOAD(p) _mm_loadu_ps(p)
+#define RC__V4_ADD(a, b) _mm_add_ps(a, b)
+#define RC__V4_DIV(a, b) _mm_div_ps(a, b)
+#define RC__V4_EQ(a, b) _mm_cmpeq_ps(a, b)
+#define RC__V4_ABS(a) _mm_andnot_ps(_mm_set1_ps(-0.0f), a)
+#define RC__V4_STORE(p, a) _mm_storeu_ps(p, a)
 static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return (uint32_t)_mm_movemask_ps(m); }
 #elif defined(RC__LEAF4_NEON)
 typedef float32x4_t rc__v4;
@@ -107,6 +112,13 @@ typedef uint32x4_t rc__v4mask;
 #define RC__V4_AND(a, b) vandq_u32(a, b)
 #define RC__V4_ORDERED(a, b) vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b))
 #define RC__V4_LOAD(p) vld1q_f32(p)
+#if defined(__aarch64__)
+#define RC__V4_ADD(a, b) vaddq_f32(a, b)
+#define RC__V4_DIV(a, b) vdivq_f32(a, b)
+#define RC__V4_EQ(a, b) vceqq_f32(a, b)
+#define RC__V4_ABS(a) vabsq_f32(a)
+#define RC__V4_STORE(p, a) vst1q_f32(p, a)
+#endif
 static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
 {
     static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
@@ -116,13 +128,37 @@ static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
 }
 #endif
 
+/* The watertight test of one ray against a leaf's (up to) four triangles,
+ * as far as the SIMD lanes take it (rc__leaf4_test): bit i of hit says
+ * triangle i is met at t[i], with barycentrics V[i] / det[i] and W[i] /
+ * det[i], unless it has zero area (rc__leaf4_take checks that, for the few
+ * triangles a ray is offered); bit i of redo says rc__tri_intersect must
+ * decide (a zero edge function, a NaN from overflow, an origin near the
+ * triangle's plane: its double-precision cases). Every other triangle misses. */
+typedef struct rc__leaf4_out {
+    float t[4], V[4], W[4], det[4];
+    uint32_t hit, redo;
+} rc__leaf4_out;
+
+#if defined(RC__LEAF4_SSE2) || (defined(RC__LEAF4_NEON) && defined(__aarch64__))
+/* The whole test in lanes, not only its reject half: every lane repeats the
+ * scalar test's operations in the same order, so t and the barycentrics are
+ * its own bit for bit, and the scalar test is left only its rare cases (it
+ * redid the shear and the edge functions for every candidate: 9% of the
+ * time of a 1k map). 32-bit ARM keeps the filter: its NEON flushes
+ * subnormals to zero and has no division. */
+#define RC__LEAF4_FULL 1
+#endif
+
 #if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
-/* Rejected lanes (bit i: triangle i) given the four triangles' a, b, c
- * coordinates along kx, ky, kz (separate arguments, not an array: an array
- * of vectors made gcc keep them in memory, +8% instructions on aarch64). */
-static RC__FORCE_INLINE uint32_t rc__leaf4_reject(const rc__ray *r, rc__v4 ax, rc__v4 ay, rc__v4 az_, rc__v4 bx,
-                                                 rc__v4 by, rc__v4 bz_, rc__v4 cx, rc__v4 cy, rc__v4 cz_)
+/* Triangles i < count given their a, b, c coordinates along kx, ky, kz
+ * (separate arguments, not an array: an array of vectors made gcc keep them
+ * in memory, +8% instructions on aarch64). */
+static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 ay, rc__v4 az_, rc__v4 bx, rc__v4 by,
+                                          rc__v4 bz_, rc__v4 cx, rc__v4 cy, rc__v4 cz_, uint32_t count,
+                                          rc__leaf4_out *o)
 {
+    const uint32_t all = (1u << count) - 1u;
     const rc__v4 ox = RC__V4_SET1(r->org[r->kx]), oy = RC__V4_SET1(r->org[r->ky]), oz = RC__V4_SET1(r->org[r->kz]);
     const rc__v4 sx = RC__V4_SET1(r->sx), sy = RC__V4_SET1(r->sy), zero = RC__V4_SET1(0.0f);
     const rc__v4 az = RC__V4_SUB(az_, oz), bz = RC__V4_SUB(bz_, oz), cz = RC__V4_SUB(cz_, oz);
@@ -132,23 +168,50 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_reject(const rc__ray *r, rc__v4 ax, r
     const rc__v4 By = RC__V4_SUB(RC__V4_SUB(by, oy), RC__V4_MUL(sy, bz));
     const rc__v4 Cx = RC__V4_SUB(RC__V4_SUB(cx, ox), RC__V4_MUL(sx, cz));
     const rc__v4 Cy = RC__V4_SUB(RC__V4_SUB(cy, oy), RC__V4_MUL(sy, cz));
-    const rc__v4 U = RC__V4_SUB(RC__V4_MUL(Cx, By), RC__V4_MUL(Cy, Bx));
-    const rc__v4 V = RC__V4_SUB(RC__V4_MUL(Ax, Cy), RC__V4_MUL(Ay, Cx));
-    const rc__v4 W = RC__V4_SUB(RC__V4_MUL(Bx, Ay), RC__V4_MUL(By, Ax));
+    const rc__v4 CxBy = RC__V4_MUL(Cx, By), CyBx = RC__V4_MUL(Cy, Bx);
+    const rc__v4 AxCy = RC__V4_MUL(Ax, Cy), AyCx = RC__V4_MUL(Ay, Cx);
+    const rc__v4 BxAy = RC__V4_MUL(Bx, Ay), ByAx = RC__V4_MUL(By, Ax);
+    const rc__v4 U = RC__V4_SUB(CxBy, CyBx), V = RC__V4_SUB(AxCy, AyCx), W = RC__V4_SUB(BxAy, ByAx);
     const rc__v4mask neg = RC__V4_OR(RC__V4_OR(RC__V4_LT(U, zero), RC__V4_LT(V, zero)), RC__V4_LT(W, zero));
     const rc__v4mask pos = RC__V4_OR(RC__V4_OR(RC__V4_GT(U, zero), RC__V4_GT(V, zero)), RC__V4_GT(W, zero));
     /* a lane with a NaN (overflow) goes to the scalar test, which orders its
      * comparisons its own way */
     const rc__v4mask ordered = RC__V4_AND(RC__V4_ORDERED(U, V), RC__V4_ORDERED(W, W));
-    return rc__v4_bits(RC__V4_AND(RC__V4_AND(neg, pos), ordered));
+    const uint32_t live = all & ~rc__v4_bits(RC__V4_AND(RC__V4_AND(neg, pos), ordered));
+#if defined(RC__LEAF4_FULL)
+    /* the scalar test's order: a zero edge function (equal products) goes to
+     * double, then det == 0 and t <= 0 miss, then a t tiny against the
+     * triangle's extent along the ray goes to double */
+    const uint32_t redo = live & ((~rc__v4_bits(ordered) & 15u) |
+                                  rc__v4_bits(RC__V4_OR(RC__V4_OR(RC__V4_EQ(CxBy, CyBx), RC__V4_EQ(AxCy, AyCx)),
+                                                        RC__V4_EQ(BxAy, ByAx))));
+    const rc__v4 sz = RC__V4_SET1(r->sz);
+    const rc__v4 det = RC__V4_ADD(RC__V4_ADD(U, V), W);
+    const rc__v4 T = RC__V4_ADD(RC__V4_ADD(RC__V4_MUL(U, RC__V4_MUL(sz, az)), RC__V4_MUL(V, RC__V4_MUL(sz, bz))),
+                                RC__V4_MUL(W, RC__V4_MUL(sz, cz)));
+    const rc__v4 tt = RC__V4_DIV(T, det);
+    const uint32_t pass = live & ~redo & ~rc__v4_bits(RC__V4_EQ(det, zero)) & rc__v4_bits(RC__V4_GT(tt, zero));
+    const rc__v4 extent = RC__V4_ADD(RC__V4_ADD(RC__V4_ABS(az), RC__V4_ABS(bz)), RC__V4_ABS(cz));
+    const uint32_t tiny =
+        pass & rc__v4_bits(RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
+    o->redo = redo | tiny;
+    o->hit = pass & ~tiny;
+    RC__V4_STORE(o->t, tt);
+    RC__V4_STORE(o->V, V);
+    RC__V4_STORE(o->W, W);
+    RC__V4_STORE(o->det, det);
+#else
+    o->redo = live;
+    o->hit = 0;
+#endif
 }
 #endif
 
-/* Bit i set for triangle i (< count) that rc__tri_intersect must still test;
- * v[i][0..2] are its vertices (slots >= count are ignored). */
-static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const float *const v[4][3], uint32_t count)
+/* rc__leaf4_out for ray r and the triangles v[i][0..2], i < count (slots
+ * past count are ignored). */
+static RC__FORCE_INLINE void rc__leaf4_test(const rc__ray *r, const float *const v[4][3], uint32_t count,
+                                           rc__leaf4_out *o)
 {
-    const uint32_t all = (1u << count) - 1u;
 #if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
     const int kx = r->kx, ky = r->ky, kz = r->kz;
     /* lane i: triangle i, or triangle 0 again for the slots past count */
@@ -156,9 +219,9 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const fl
     const float *const *p2 = v[count > 2u ? 2 : 0], *const *p3 = v[count > 3u ? 3 : 0];
 #if defined(RC__LEAF4_SSE2)
 #define RC__LEAF4_GATHER(vtx, k) _mm_setr_ps(p0[vtx][k], p1[vtx][k], p2[vtx][k], p3[vtx][k])
-    return all & ~rc__leaf4_reject(r, RC__LEAF4_GATHER(0, kx), RC__LEAF4_GATHER(0, ky), RC__LEAF4_GATHER(0, kz),
-                                   RC__LEAF4_GATHER(1, kx), RC__LEAF4_GATHER(1, ky), RC__LEAF4_GATHER(1, kz),
-                                   RC__LEAF4_GATHER(2, kx), RC__LEAF4_GATHER(2, ky), RC__LEAF4_GATHER(2, kz));
+    rc__leaf4_run(r, RC__LEAF4_GATHER(0, kx), RC__LEAF4_GATHER(0, ky), RC__LEAF4_GATHER(0, kz),
+                  RC__LEAF4_GATHER(1, kx), RC__LEAF4_GATHER(1, ky), RC__LEAF4_GATHER(1, kz), RC__LEAF4_GATHER(2, kx),
+                  RC__LEAF4_GATHER(2, ky), RC__LEAF4_GATHER(2, kz), count, o);
 #else
     /* NEON: one table, nine loads (building each vector lane by lane measured
      * 8% more instructions over the single-ray traversal) */
@@ -166,31 +229,51 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_candidates(const rc__ray *r, const fl
     const float c[9][4] = {RC__LEAF4_GATHER(0, kx), RC__LEAF4_GATHER(0, ky), RC__LEAF4_GATHER(0, kz),
                            RC__LEAF4_GATHER(1, kx), RC__LEAF4_GATHER(1, ky), RC__LEAF4_GATHER(1, kz),
                            RC__LEAF4_GATHER(2, kx), RC__LEAF4_GATHER(2, ky), RC__LEAF4_GATHER(2, kz)};
-    return all & ~rc__leaf4_reject(r, vld1q_f32(c[0]), vld1q_f32(c[1]), vld1q_f32(c[2]), vld1q_f32(c[3]),
-                                   vld1q_f32(c[4]), vld1q_f32(c[5]), vld1q_f32(c[6]), vld1q_f32(c[7]),
-                                   vld1q_f32(c[8]));
+    rc__leaf4_run(r, vld1q_f32(c[0]), vld1q_f32(c[1]), vld1q_f32(c[2]), vld1q_f32(c[3]), vld1q_f32(c[4]),
+                  vld1q_f32(c[5]), vld1q_f32(c[6]), vld1q_f32(c[7]), vld1q_f32(c[8]), count, o);
 #endif
 #undef RC__LEAF4_GATHER
 #else
     (void)r;
     (void)v;
-    return all;
+    o->redo = (1u << count) - 1u;
+    o->hit = 0;
 #endif
 }
 
-/* rc__leaf4_candidates from a transposed leaf (the same tests, bit for bit). */
-static RC__FORCE_INLINE uint32_t rc__leaf4_candidates_soa(const rc__ray *r, const rc__leaf4_soa *s, uint32_t count)
+/* rc__leaf4_test from a transposed leaf (the same tests, bit for bit). */
+static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf4_soa *s, uint32_t count,
+                                               rc__leaf4_out *o)
 {
-    const uint32_t all = (1u << count) - 1u;
 #if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
     const int kx = r->kx, ky = r->ky, kz = r->kz;
-    return all & ~rc__leaf4_reject(r, RC__V4_LOAD(s->c[0][kx]), RC__V4_LOAD(s->c[0][ky]), RC__V4_LOAD(s->c[0][kz]),
-                                   RC__V4_LOAD(s->c[1][kx]), RC__V4_LOAD(s->c[1][ky]), RC__V4_LOAD(s->c[1][kz]),
-                                   RC__V4_LOAD(s->c[2][kx]), RC__V4_LOAD(s->c[2][ky]), RC__V4_LOAD(s->c[2][kz]));
+    rc__leaf4_run(r, RC__V4_LOAD(s->c[0][kx]), RC__V4_LOAD(s->c[0][ky]), RC__V4_LOAD(s->c[0][kz]),
+                  RC__V4_LOAD(s->c[1][kx]), RC__V4_LOAD(s->c[1][ky]), RC__V4_LOAD(s->c[1][kz]),
+                  RC__V4_LOAD(s->c[2][kx]), RC__V4_LOAD(s->c[2][ky]), RC__V4_LOAD(s->c[2][kz]), count, o);
 #else
     (void)r;
     (void)s;
-    return all;
+    o->redo = (1u << count) - 1u;
+    o->hit = 0;
+#endif
+}
+
+/* Triangle c of a leaf tested by rc__leaf4_test: 1 with *t, *u, *v as
+ * rc__tri_intersect gives them when it is hit, else 0. tv: its vertices. */
+static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, const rc__ray *r,
+                                          const float *const tv[3], float *t, float *u, float *v)
+{
+#if defined(RC__LEAF4_FULL)
+    if ((o->redo >> c) & 1u) return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, u, v);
+    if (rc__tri_zero_area(tv[0], tv[1], tv[2])) return 0;
+    *t = o->t[c];
+    *u = o->V[c] / o->det[c];
+    *v = o->W[c] / o->det[c];
+    return 1;
+#else
+    (void)o;
+    (void)c;
+    return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, u, v);
 #endif
 }
 

@@ -542,12 +542,12 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         return 1;
     } else {
         /* lane by lane: the leaf's four triangles (transposed once for all
-         * lanes) through the SIMD filter, then the watertight test on what
-         * is left */
+         * lanes) through the SIMD watertight test (leaf4.h) */
         const rc__ray *rays = T->rays;
         const float *vt[4][3];
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
         rc__leaf4_soa soa RC__ALIGN16;
+        rc__leaf4_out lo;
         uint32_t m = mask;
         int shrunk = 0;
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
@@ -555,13 +555,14 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             const uint32_t lane = lowest_lane(m);
             uint32_t cand;
             m &= m - 1u;
-            cand = rc__leaf4_candidates_soa(&rays[lane], &soa, n_tri);
+            rc__leaf4_test_soa(&rays[lane], &soa, n_tri, &lo);
+            cand = lo.hit | lo.redo;
             while (cand) {
                 uint32_t c = 0;
                 float t, u, v;
                 while (!((cand >> c) & 1u)) ++c;
                 cand &= cand - 1u;
-                if (!rc__tri_intersect(&rays[lane], vt[c][0], vt[c][1], vt[c][2], &t, &u, &v)) continue;
+                if (!rc__leaf4_take(&lo, c, &rays[lane], vt[c], &t, &u, &v)) continue;
                 if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
                 lane_set_tmax(L, lane, t);
                 T->found[lane] = 1;

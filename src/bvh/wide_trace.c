@@ -131,15 +131,17 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
             }
         } else {
             const float *vt[4][3];
+            rc__leaf4_out lo;
             uint32_t cand;
             count = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
-            cand = rc__leaf4_candidates(&r, (const float *const(*)[3])vt, count);
+            rc__leaf4_test(&r, (const float *const(*)[3])vt, count, &lo);
+            cand = lo.hit | lo.redo;
             while (cand) {
                 const uint32_t j = child + lowest_bit(cand);
                 const float *const *tv = vt[j - child];
                 float t, u, v;
                 cand &= cand - 1u;
-                if (!rc__tri_intersect(&r, tv[0], tv[1], tv[2], &t, &u, &v)) continue;
+                if (!rc__leaf4_take(&lo, j - child, &r, tv, &t, &u, &v)) continue;
                 if (any_hit) {
                     if (t < tmax) return 1;
                     continue;
@@ -239,13 +241,16 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
     } else {
         const float *vt[4][3];
         const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
-        uint32_t cand = rc__leaf4_candidates(&T->r, (const float *const(*)[3])vt, count);
+        rc__leaf4_out lo;
+        uint32_t cand;
+        rc__leaf4_test(&T->r, (const float *const(*)[3])vt, count, &lo);
+        cand = lo.hit | lo.redo;
         while (cand) {
             const uint32_t j = T->child + lowest_bit(cand);
             const float *const *tv = vt[j - T->child];
             float t, u, v;
             cand &= cand - 1u;
-            if (!rc__tri_intersect(&T->r, tv[0], tv[1], tv[2], &t, &u, &v)) continue;
+            if (!rc__leaf4_take(&lo, j - T->child, &T->r, tv, &t, &u, &v)) continue;
             if (t > T->tcur || !rc__hit_offer_slot(T->hit, t, u, v, mesh->bvh.refs, j, geom, inst)) continue;
             T->tcur = t;
             T->found = 1;
