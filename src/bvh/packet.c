@@ -548,7 +548,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
         rc__leaf4_soa soa RC__ALIGN16;
         rc__leaf4_out lo;
-        uint32_t m = mask;
+        uint32_t m = mask, known = 0, flat = 0;
         int shrunk = 0;
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
         while (m) {
@@ -562,7 +562,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
                 float t, u, v;
                 while (!((cand >> c) & 1u)) ++c;
                 cand &= cand - 1u;
-                if (!rc__leaf4_take(&lo, c, &rays[lane], vt[c], &t, &u, &v)) continue;
+                if (!rc__leaf4_take(&lo, c, &rays[lane], vt[c], &known, &flat, &t, &u, &v)) continue;
                 if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
                 lane_set_tmax(L, lane, t);
                 T->found[lane] = 1;

@@ -132,7 +132,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
         } else {
             const float *vt[4][3];
             rc__leaf4_out lo;
-            uint32_t cand;
+            uint32_t cand, known = 0, flat = 0;
             count = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
             rc__leaf4_test(&r, (const float *const(*)[3])vt, count, &lo);
             cand = lo.hit | lo.redo;
@@ -141,7 +141,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                 const float *const *tv = vt[j - child];
                 float t, u, v;
                 cand &= cand - 1u;
-                if (!rc__leaf4_take(&lo, j - child, &r, tv, &t, &u, &v)) continue;
+                if (!rc__leaf4_take(&lo, j - child, &r, tv, &known, &flat, &t, &u, &v)) continue;
                 if (any_hit) {
                     if (t < tmax) return 1;
                     continue;
@@ -242,7 +242,7 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
         const float *vt[4][3];
         const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
         rc__leaf4_out lo;
-        uint32_t cand;
+        uint32_t cand, known = 0, flat = 0;
         rc__leaf4_test(&T->r, (const float *const(*)[3])vt, count, &lo);
         cand = lo.hit | lo.redo;
         while (cand) {
@@ -250,7 +250,7 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
             const float *const *tv = vt[j - T->child];
             float t, u, v;
             cand &= cand - 1u;
-            if (!rc__leaf4_take(&lo, j - T->child, &T->r, tv, &t, &u, &v)) continue;
+            if (!rc__leaf4_take(&lo, j - T->child, &T->r, tv, &known, &flat, &t, &u, &v)) continue;
             if (t > T->tcur || !rc__hit_offer_slot(T->hit, t, u, v, mesh->bvh.refs, j, geom, inst)) continue;
             T->tcur = t;
             T->found = 1;
