@@ -185,21 +185,31 @@ static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 a
     const uint32_t redo = live & ((~rc__v4_bits(ordered) & 15u) |
                                   rc__v4_bits(RC__V4_OR(RC__V4_OR(RC__V4_EQ(CxBy, CyBx), RC__V4_EQ(AxCy, AyCx)),
                                                         RC__V4_EQ(BxAy, ByAx))));
-    const rc__v4 sz = RC__V4_SET1(r->sz);
-    const rc__v4 det = RC__V4_ADD(RC__V4_ADD(U, V), W);
-    const rc__v4 T = RC__V4_ADD(RC__V4_ADD(RC__V4_MUL(U, RC__V4_MUL(sz, az)), RC__V4_MUL(V, RC__V4_MUL(sz, bz))),
-                                RC__V4_MUL(W, RC__V4_MUL(sz, cz)));
-    const rc__v4 tt = RC__V4_DIV(T, det);
-    const uint32_t pass = live & ~redo & ~rc__v4_bits(RC__V4_EQ(det, zero)) & rc__v4_bits(RC__V4_GT(tt, zero));
-    const rc__v4 extent = RC__V4_ADD(RC__V4_ADD(RC__V4_ABS(az), RC__V4_ABS(bz)), RC__V4_ABS(cz));
-    const uint32_t tiny =
-        pass & rc__v4_bits(RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
-    o->redo = redo | tiny;
-    o->hit = pass & ~tiny;
-    RC__V4_STORE(o->t, tt);
-    RC__V4_STORE(o->V, V);
-    RC__V4_STORE(o->W, W);
-    RC__V4_STORE(o->det, det);
+    o->redo = redo;
+    o->hit = 0;
+    if (live & ~redo) {
+        const rc__v4 sz = RC__V4_SET1(r->sz);
+        const rc__v4 det = RC__V4_ADD(RC__V4_ADD(U, V), W);
+        const rc__v4 T = RC__V4_ADD(RC__V4_ADD(RC__V4_MUL(U, RC__V4_MUL(sz, az)), RC__V4_MUL(V, RC__V4_MUL(sz, bz))),
+                                    RC__V4_MUL(W, RC__V4_MUL(sz, cz)));
+        const rc__v4 tt = RC__V4_DIV(T, det);
+        const uint32_t pass = live & ~redo & ~rc__v4_bits(RC__V4_EQ(det, zero)) & rc__v4_bits(RC__V4_GT(tt, zero));
+        const rc__v4 extent = RC__V4_ADD(RC__V4_ADD(RC__V4_ABS(az), RC__V4_ABS(bz)), RC__V4_ABS(cz));
+        const uint32_t tiny =
+            pass & rc__v4_bits(RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
+        o->redo = redo | tiny;
+        o->hit = pass & ~tiny;
+        RC__V4_STORE(o->t, tt);
+        RC__V4_STORE(o->V, V);
+        RC__V4_STORE(o->W, W);
+        RC__V4_STORE(o->det, det);
+    } else {
+        /* never read (no hit bit); stored so no path reads them unset */
+        RC__V4_STORE(o->t, zero);
+        RC__V4_STORE(o->V, zero);
+        RC__V4_STORE(o->W, zero);
+        RC__V4_STORE(o->det, zero);
+    }
 #else
     o->redo = live;
     o->hit = 0;
