@@ -99,6 +99,8 @@ typedef __m128 rc__v4mask;
 #define RC__V4_EQ(a, b) _mm_cmpeq_ps(a, b)
 #define RC__V4_ABS(a) _mm_andnot_ps(_mm_set1_ps(-0.0f), a)
 #define RC__V4_STORE(p, a) _mm_storeu_ps(p, a)
+#define RC__V4_ANDNOT(a, b) _mm_andnot_ps(a, b) /* ~a & b */
+#define RC__V4_UNORDERED(a, b) _mm_cmpunord_ps(a, b)
 static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return (uint32_t)_mm_movemask_ps(m); }
 #elif defined(RC__LEAF4_NEON)
 typedef float32x4_t rc__v4;
@@ -118,6 +120,8 @@ typedef uint32x4_t rc__v4mask;
 #define RC__V4_EQ(a, b) vceqq_f32(a, b)
 #define RC__V4_ABS(a) vabsq_f32(a)
 #define RC__V4_STORE(p, a) vst1q_f32(p, a)
+#define RC__V4_ANDNOT(a, b) vbicq_u32(b, a) /* ~a & b */
+#define RC__V4_UNORDERED(a, b) vmvnq_u32(RC__V4_ORDERED(a, b))
 #endif
 static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
 {
@@ -177,33 +181,36 @@ static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 a
     /* a lane with a NaN (overflow) goes to the scalar test, which orders its
      * comparisons its own way */
     const rc__v4mask ordered = RC__V4_AND(RC__V4_ORDERED(U, V), RC__V4_ORDERED(W, W));
-    const uint32_t live = all & ~rc__v4_bits(RC__V4_AND(RC__V4_AND(neg, pos), ordered));
+    const rc__v4mask rejected = RC__V4_AND(RC__V4_AND(neg, pos), ordered);
 #if defined(RC__LEAF4_FULL)
-    /* the scalar test's order: a zero edge function (equal products) goes to
-     * double, then det == 0 and t <= 0 miss, then a t tiny against the
-     * triangle's extent along the ray goes to double */
-    const uint32_t redo = live & ((~rc__v4_bits(ordered) & 15u) |
-                                  rc__v4_bits(RC__V4_OR(RC__V4_OR(RC__V4_EQ(CxBy, CyBx), RC__V4_EQ(AxCy, AyCx)),
-                                                        RC__V4_EQ(BxAy, ByAx))));
-    o->redo = redo;
-    o->hit = 0;
-    if (live & ~redo) {
+    /* the scalar test's order: a NaN or a zero edge function (equal
+     * products) goes to double, then det == 0 and t <= 0 miss, then a t tiny
+     * against the triangle's extent along the ray goes to double. The lanes'
+     * conditions are combined as masks and read out as bits three times at
+     * most (a read-out is five instructions on NEON). */
+    const rc__v4mask redo = RC__V4_ANDNOT(
+        rejected, RC__V4_OR(RC__V4_OR(RC__V4_UNORDERED(U, V), RC__V4_UNORDERED(W, W)),
+                            RC__V4_OR(RC__V4_OR(RC__V4_EQ(CxBy, CyBx), RC__V4_EQ(AxCy, AyCx)), RC__V4_EQ(BxAy, ByAx))));
+    const rc__v4mask settled = RC__V4_OR(rejected, redo);
+    if (all & ~rc__v4_bits(settled)) {
         const rc__v4 sz = RC__V4_SET1(r->sz);
         const rc__v4 det = RC__V4_ADD(RC__V4_ADD(U, V), W);
         const rc__v4 T = RC__V4_ADD(RC__V4_ADD(RC__V4_MUL(U, RC__V4_MUL(sz, az)), RC__V4_MUL(V, RC__V4_MUL(sz, bz))),
                                     RC__V4_MUL(W, RC__V4_MUL(sz, cz)));
         const rc__v4 tt = RC__V4_DIV(T, det);
-        const uint32_t pass = live & ~redo & ~rc__v4_bits(RC__V4_EQ(det, zero)) & rc__v4_bits(RC__V4_GT(tt, zero));
+        const rc__v4mask pass = RC__V4_ANDNOT(RC__V4_OR(settled, RC__V4_EQ(det, zero)), RC__V4_GT(tt, zero));
         const rc__v4 extent = RC__V4_ADD(RC__V4_ADD(RC__V4_ABS(az), RC__V4_ABS(bz)), RC__V4_ABS(cz));
-        const uint32_t tiny =
-            pass & rc__v4_bits(RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
-        o->redo = redo | tiny;
-        o->hit = pass & ~tiny;
+        const rc__v4mask tiny =
+            RC__V4_AND(pass, RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
+        o->redo = all & rc__v4_bits(RC__V4_OR(redo, tiny));
+        o->hit = all & rc__v4_bits(RC__V4_ANDNOT(tiny, pass));
         RC__V4_STORE(o->t, tt);
         RC__V4_STORE(o->V, V);
         RC__V4_STORE(o->W, W);
         RC__V4_STORE(o->det, det);
     } else {
+        o->redo = all & rc__v4_bits(redo);
+        o->hit = 0;
         /* never read (no hit bit); stored so no path reads them unset */
         RC__V4_STORE(o->t, zero);
         RC__V4_STORE(o->V, zero);
@@ -211,7 +218,7 @@ static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 a
         RC__V4_STORE(o->det, zero);
     }
 #else
-    o->redo = live;
+    o->redo = all & ~rc__v4_bits(rejected);
     o->hit = 0;
 #endif
 }
