@@ -144,6 +144,16 @@ typedef struct rc__leaf4_out {
     uint32_t hit, redo;
 } rc__leaf4_out;
 
+#if defined(RC__LEAF4_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(RC__LEAF4_NO_AVX2)
+/* Two rays at once in 8-wide AVX2 lanes (leaf4_avx2.c), for packets on CPUs
+ * that have it: rc__leaf4_test_soa for ra into *oa and rb into *ob, the same
+ * outputs bit for bit. Call it only where rc__leaf4_have_avx2() is 1. */
+#define RC__LEAF4_PAIR_AVX2 1
+int rc__leaf4_have_avx2(void);
+void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb, const rc__leaf4_soa *s, uint32_t count,
+                             rc__leaf4_out *oa, rc__leaf4_out *ob);
+#endif
+
 #if defined(RC__LEAF4_SSE2) || (defined(RC__LEAF4_NEON) && defined(__aarch64__))
 /* The whole test in lanes, not only its reject half: every lane repeats the
  * scalar test's operations in the same order, so t and the barycentrics are

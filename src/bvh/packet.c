@@ -360,6 +360,7 @@ typedef struct packet_trav {
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
+    int avx2;          /* leaves test two lanes at once (rc__leaf4_have_avx2) */
     /* up to three pushes per level */
     packet_entry stack[PACKET_STACK];
 } packet_trav;
@@ -475,7 +476,34 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
     T->child = 0;
     T->count = 0;
     T->staged = T->settling = 0;
+#if defined(RC__LEAF4_PAIR_AVX2)
+    T->avx2 = rc__leaf4_have_avx2();
+#else
+    T->avx2 = 0;
+#endif
     return 1;
+}
+
+/* Offers lane's hits among a leaf's triangles (first slot child, vertices
+ * vt) as rc__leaf4_test found them in *lo; 1 when the lane's tmax shrank. */
+static RC__FORCE_INLINE int leaf_lane_offer(packet_trav *T, const rc__mesh *mesh, const float *vt[4][3],
+                                            uint32_t child, uint32_t lane, const rc__leaf4_out *lo, uint32_t *known,
+                                            uint32_t *flat, uint32_t geom, uint32_t inst)
+{
+    uint32_t cand = lo->hit | lo->redo;
+    int shrunk = 0;
+    while (cand) {
+        uint32_t c = 0;
+        float t, u, v;
+        while (!((cand >> c) & 1u)) ++c;
+        cand &= cand - 1u;
+        if (!rc__leaf4_take(lo, c, &T->rays[lane], vt[c], known, flat, &t, &u, &v)) continue;
+        if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
+        lane_set_tmax(&T->L, lane, t);
+        T->found[lane] = 1;
+        shrunk = 1;
+    }
+    return shrunk;
 }
 
 /* Handles T's current node or leaf and moves to the next entry. With
@@ -542,7 +570,8 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         return 1;
     } else {
         /* lane by lane: the leaf's four triangles (transposed once for all
-         * lanes) through the SIMD watertight test (leaf4.h) */
+         * lanes) through the SIMD watertight test (leaf4.h); two lanes at a
+         * time where the CPU has AVX2 */
         const rc__ray *rays = T->rays;
         const float *vt[4][3];
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
@@ -553,21 +582,20 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
         while (m) {
             const uint32_t lane = lowest_lane(m);
-            uint32_t cand;
             m &= m - 1u;
-            rc__leaf4_test_soa(&rays[lane], &soa, n_tri, &lo);
-            cand = lo.hit | lo.redo;
-            while (cand) {
-                uint32_t c = 0;
-                float t, u, v;
-                while (!((cand >> c) & 1u)) ++c;
-                cand &= cand - 1u;
-                if (!rc__leaf4_take(&lo, c, &rays[lane], vt[c], &known, &flat, &t, &u, &v)) continue;
-                if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
-                lane_set_tmax(L, lane, t);
-                T->found[lane] = 1;
-                shrunk = 1;
+#if defined(RC__LEAF4_PAIR_AVX2)
+            if (m && T->avx2) {
+                const uint32_t lane2 = lowest_lane(m);
+                rc__leaf4_out lo2;
+                m &= m - 1u;
+                rc__leaf4_test_soa_pair(&rays[lane], &rays[lane2], &soa, n_tri, &lo, &lo2);
+                shrunk |= leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst);
+                shrunk |= leaf_lane_offer(T, mesh, vt, child, lane2, &lo2, &known, &flat, geom, inst);
+                continue;
             }
+#endif
+            rc__leaf4_test_soa(&rays[lane], &soa, n_tri, &lo);
+            shrunk |= leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst);
         }
         if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L); /* hits only shrink tmax: tighten the bound */
     }
