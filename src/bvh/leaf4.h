@@ -13,6 +13,8 @@
 
 #include "bvh/intersect.h"
 
+#include <float.h>
+
 #if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
 #include <emmintrin.h>
 #define RC__LEAF4_SSE2 1
@@ -228,8 +230,30 @@ static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 a
         RC__V4_STORE(o->det, zero);
     }
 #else
-    o->redo = all & ~rc__v4_bits(rejected);
-    o->hit = 0;
+    /* 32-bit ARM: NEON flushes subnormal operands and results to zero where
+     * the scalar test (VFP) keeps them, so its values can differ from the
+     * scalar test's wherever one of them lies below FLT_MIN in magnitude (a
+     * flushed one reads as zero there). Such a lane is left to the scalar
+     * test instead of being rejected (test_leaf4 found a direction whose
+     * shear constant was subnormal, under qemu-arm). */
+    {
+        const float32x4_t lim = vdupq_n_f32(FLT_MIN);
+#define RC__LEAF4_SMALL3(a, b, c) vorrq_u32(vorrq_u32(vcaltq_f32(a, lim), vcaltq_f32(b, lim)), vcaltq_f32(c, lim))
+        const uint32x4_t inputs = vorrq_u32(
+            vorrq_u32(RC__LEAF4_SMALL3(ax, ay, az_), RC__LEAF4_SMALL3(bx, by, bz_)),
+            vorrq_u32(RC__LEAF4_SMALL3(cx, cy, cz_), vorrq_u32(RC__LEAF4_SMALL3(ox, oy, oz), RC__LEAF4_SMALL3(sx, sy, sy))));
+        const uint32x4_t shear = vorrq_u32(
+            vorrq_u32(RC__LEAF4_SMALL3(az, bz, cz), RC__LEAF4_SMALL3(vsubq_f32(ax, ox), vsubq_f32(ay, oy), vsubq_f32(bx, ox))),
+            vorrq_u32(RC__LEAF4_SMALL3(vsubq_f32(by, oy), vsubq_f32(cx, ox), vsubq_f32(cy, oy)),
+                      vorrq_u32(RC__LEAF4_SMALL3(vmulq_f32(sx, az), vmulq_f32(sy, az), vmulq_f32(sx, bz)),
+                                RC__LEAF4_SMALL3(vmulq_f32(sy, bz), vmulq_f32(sx, cz), vmulq_f32(sy, cz)))));
+        const uint32x4_t edges = vorrq_u32(
+            vorrq_u32(RC__LEAF4_SMALL3(Ax, Ay, Bx), RC__LEAF4_SMALL3(By, Cx, Cy)),
+            vorrq_u32(RC__LEAF4_SMALL3(CxBy, CyBx, AxCy), RC__LEAF4_SMALL3(AyCx, BxAy, ByAx)));
+#undef RC__LEAF4_SMALL3
+        o->redo = all & ~rc__v4_bits(vbicq_u32(rejected, vorrq_u32(inputs, vorrq_u32(shear, edges))));
+        o->hit = 0;
+    }
 #endif
 }
 #endif
