@@ -82,8 +82,9 @@ static RC__FORCE_INLINE void rc__leaf4_transpose(const float *const v[4][3], uin
     }
 }
 
-/* Four float lanes, written once for SSE2 and NEON: the filter below uses
- * only these operations (no fused multiply-add: products round as in C). */
+/* Four float lanes, written once for SSE2 and NEON: the lane body
+ * (leaf4_lanes.h) uses only these operations (no fused multiply-add:
+ * products round as in C). */
 #if defined(RC__LEAF4_SSE2)
 typedef __m128 rc__v4;
 typedef __m128 rc__v4mask;
@@ -116,14 +117,14 @@ typedef uint32x4_t rc__v4mask;
 #define RC__V4_AND(a, b) vandq_u32(a, b)
 #define RC__V4_ORDERED(a, b) vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b))
 #define RC__V4_LOAD(p) vld1q_f32(p)
-#if defined(__aarch64__)
 #define RC__V4_ADD(a, b) vaddq_f32(a, b)
-#define RC__V4_DIV(a, b) vdivq_f32(a, b)
 #define RC__V4_EQ(a, b) vceqq_f32(a, b)
 #define RC__V4_ABS(a) vabsq_f32(a)
 #define RC__V4_STORE(p, a) vst1q_f32(p, a)
 #define RC__V4_ANDNOT(a, b) vbicq_u32(b, a) /* ~a & b */
 #define RC__V4_UNORDERED(a, b) vmvnq_u32(RC__V4_ORDERED(a, b))
+#if defined(__aarch64__)
+#define RC__V4_DIV(a, b) vdivq_f32(a, b) /* 32-bit NEON has no division */
 #endif
 static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
 {
@@ -151,7 +152,9 @@ typedef struct rc__leaf4_out {
  * that have it: rc__leaf4_test_soa for ra into *oa and rb into *ob, the same
  * outputs bit for bit. Call it only where rc__leaf4_have_avx2() is 1. */
 #define RC__LEAF4_PAIR_AVX2 1
-int rc__leaf4_have_avx2(void);
+/* a load and a bit test (libgcc's CPU model, filled at start-up; it counts
+ * AVX2 only where the OS saves the wide registers): cheap enough per packet */
+static RC__FORCE_INLINE int rc__leaf4_have_avx2(void) { return __builtin_cpu_supports("avx2") ? 1 : 0; }
 void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb, const rc__leaf4_soa *s, uint32_t count,
                              rc__leaf4_out *oa, rc__leaf4_out *ob);
 #endif
@@ -167,93 +170,69 @@ void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb, const rc__lea
 #endif
 
 #if defined(RC__LEAF4_SSE2) || defined(RC__LEAF4_NEON)
+/* The lane body (leaf4_lanes.h) for four lanes. */
+#define RC__VL_NAME rc__leaf4_lanes
+#define RC__VL_ATTR
+#define RC__VL_T rc__v4
+#define RC__VL_M rc__v4mask
+#define RC__VL_SET1 RC__V4_SET1
+#define RC__VL_SUB RC__V4_SUB
+#define RC__VL_ADD RC__V4_ADD
+#define RC__VL_MUL RC__V4_MUL
+#define RC__VL_DIV RC__V4_DIV
+#define RC__VL_LT RC__V4_LT
+#define RC__VL_GT RC__V4_GT
+#define RC__VL_EQ RC__V4_EQ
+#define RC__VL_ORDERED RC__V4_ORDERED
+#define RC__VL_UNORDERED RC__V4_UNORDERED
+#define RC__VL_OR RC__V4_OR
+#define RC__VL_AND RC__V4_AND
+#define RC__VL_ANDNOT RC__V4_ANDNOT
+#define RC__VL_ABS RC__V4_ABS
+#define RC__VL_BITS rc__v4_bits
+#if !defined(RC__LEAF4_FULL)
+#define RC__VL_FILTER_ONLY 1
+#define RC__VL_TINY(a) vcaltq_f32(a, vdupq_n_f32(FLT_MIN))
+#endif
+#include "bvh/leaf4_lanes.h"
+#undef RC__VL_NAME
+#undef RC__VL_ATTR
+#undef RC__VL_T
+#undef RC__VL_M
+#undef RC__VL_SET1
+#undef RC__VL_SUB
+#undef RC__VL_ADD
+#undef RC__VL_MUL
+#undef RC__VL_DIV
+#undef RC__VL_LT
+#undef RC__VL_GT
+#undef RC__VL_EQ
+#undef RC__VL_ORDERED
+#undef RC__VL_UNORDERED
+#undef RC__VL_OR
+#undef RC__VL_AND
+#undef RC__VL_ANDNOT
+#undef RC__VL_ABS
+#undef RC__VL_BITS
+#undef RC__VL_FILTER_ONLY
+#undef RC__VL_TINY
+
 /* Triangles i < count given their a, b, c coordinates along kx, ky, kz
  * (separate arguments, not an array: an array of vectors made gcc keep them
  * in memory, +8% instructions on aarch64). */
-static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 ay, rc__v4 az_, rc__v4 bx, rc__v4 by,
-                                          rc__v4 bz_, rc__v4 cx, rc__v4 cy, rc__v4 cz_, uint32_t count,
+static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 ay, rc__v4 az, rc__v4 bx, rc__v4 by,
+                                          rc__v4 bz, rc__v4 cx, rc__v4 cy, rc__v4 cz, uint32_t count,
                                           rc__leaf4_out *o)
 {
-    const uint32_t all = (1u << count) - 1u;
-    const rc__v4 ox = RC__V4_SET1(r->org[r->kx]), oy = RC__V4_SET1(r->org[r->ky]), oz = RC__V4_SET1(r->org[r->kz]);
-    const rc__v4 sx = RC__V4_SET1(r->sx), sy = RC__V4_SET1(r->sy), zero = RC__V4_SET1(0.0f);
-    const rc__v4 az = RC__V4_SUB(az_, oz), bz = RC__V4_SUB(bz_, oz), cz = RC__V4_SUB(cz_, oz);
-    const rc__v4 Ax = RC__V4_SUB(RC__V4_SUB(ax, ox), RC__V4_MUL(sx, az));
-    const rc__v4 Ay = RC__V4_SUB(RC__V4_SUB(ay, oy), RC__V4_MUL(sy, az));
-    const rc__v4 Bx = RC__V4_SUB(RC__V4_SUB(bx, ox), RC__V4_MUL(sx, bz));
-    const rc__v4 By = RC__V4_SUB(RC__V4_SUB(by, oy), RC__V4_MUL(sy, bz));
-    const rc__v4 Cx = RC__V4_SUB(RC__V4_SUB(cx, ox), RC__V4_MUL(sx, cz));
-    const rc__v4 Cy = RC__V4_SUB(RC__V4_SUB(cy, oy), RC__V4_MUL(sy, cz));
-    const rc__v4 CxBy = RC__V4_MUL(Cx, By), CyBx = RC__V4_MUL(Cy, Bx);
-    const rc__v4 AxCy = RC__V4_MUL(Ax, Cy), AyCx = RC__V4_MUL(Ay, Cx);
-    const rc__v4 BxAy = RC__V4_MUL(Bx, Ay), ByAx = RC__V4_MUL(By, Ax);
-    const rc__v4 U = RC__V4_SUB(CxBy, CyBx), V = RC__V4_SUB(AxCy, AyCx), W = RC__V4_SUB(BxAy, ByAx);
-    const rc__v4mask neg = RC__V4_OR(RC__V4_OR(RC__V4_LT(U, zero), RC__V4_LT(V, zero)), RC__V4_LT(W, zero));
-    const rc__v4mask pos = RC__V4_OR(RC__V4_OR(RC__V4_GT(U, zero), RC__V4_GT(V, zero)), RC__V4_GT(W, zero));
-    /* a lane with a NaN (overflow) goes to the scalar test, which orders its
-     * comparisons its own way */
-    const rc__v4mask ordered = RC__V4_AND(RC__V4_ORDERED(U, V), RC__V4_ORDERED(W, W));
-    const rc__v4mask rejected = RC__V4_AND(RC__V4_AND(neg, pos), ordered);
+    rc__v4 t, V, W, det;
+    rc__leaf4_lanes(ax, ay, az, bx, by, bz, cx, cy, cz, RC__V4_SET1(r->org[r->kx]), RC__V4_SET1(r->org[r->ky]),
+                    RC__V4_SET1(r->org[r->kz]), RC__V4_SET1(r->sx), RC__V4_SET1(r->sy), RC__V4_SET1(r->sz),
+                    (1u << count) - 1u, &o->hit, &o->redo, &t, &V, &W, &det);
 #if defined(RC__LEAF4_FULL)
-    /* the scalar test's order: a NaN or a zero edge function (equal
-     * products) goes to double, then det == 0 and t <= 0 miss, then a t tiny
-     * against the triangle's extent along the ray goes to double. The lanes'
-     * conditions are combined as masks and read out as bits three times at
-     * most (a read-out is five instructions on NEON). */
-    const rc__v4mask redo = RC__V4_ANDNOT(
-        rejected, RC__V4_OR(RC__V4_OR(RC__V4_UNORDERED(U, V), RC__V4_UNORDERED(W, W)),
-                            RC__V4_OR(RC__V4_OR(RC__V4_EQ(CxBy, CyBx), RC__V4_EQ(AxCy, AyCx)), RC__V4_EQ(BxAy, ByAx))));
-    const rc__v4mask settled = RC__V4_OR(rejected, redo);
-    if (all & ~rc__v4_bits(settled)) {
-        const rc__v4 sz = RC__V4_SET1(r->sz);
-        const rc__v4 det = RC__V4_ADD(RC__V4_ADD(U, V), W);
-        const rc__v4 T = RC__V4_ADD(RC__V4_ADD(RC__V4_MUL(U, RC__V4_MUL(sz, az)), RC__V4_MUL(V, RC__V4_MUL(sz, bz))),
-                                    RC__V4_MUL(W, RC__V4_MUL(sz, cz)));
-        const rc__v4 tt = RC__V4_DIV(T, det);
-        const rc__v4mask pass = RC__V4_ANDNOT(RC__V4_OR(settled, RC__V4_EQ(det, zero)), RC__V4_GT(tt, zero));
-        const rc__v4 extent = RC__V4_ADD(RC__V4_ADD(RC__V4_ABS(az), RC__V4_ABS(bz)), RC__V4_ABS(cz));
-        const rc__v4mask tiny =
-            RC__V4_AND(pass, RC__V4_LT(RC__V4_MUL(tt, RC__V4_SET1(1024.0f)), RC__V4_MUL(RC__V4_ABS(sz), extent)));
-        o->redo = all & rc__v4_bits(RC__V4_OR(redo, tiny));
-        o->hit = all & rc__v4_bits(RC__V4_ANDNOT(tiny, pass));
-        RC__V4_STORE(o->t, tt);
-        RC__V4_STORE(o->V, V);
-        RC__V4_STORE(o->W, W);
-        RC__V4_STORE(o->det, det);
-    } else {
-        o->redo = all & rc__v4_bits(redo);
-        o->hit = 0;
-        /* never read (no hit bit); stored so no path reads them unset */
-        RC__V4_STORE(o->t, zero);
-        RC__V4_STORE(o->V, zero);
-        RC__V4_STORE(o->W, zero);
-        RC__V4_STORE(o->det, zero);
-    }
-#else
-    /* 32-bit ARM: NEON flushes subnormal operands and results to zero where
-     * the scalar test (VFP) keeps them, so its values can differ from the
-     * scalar test's wherever one of them lies below FLT_MIN in magnitude (a
-     * flushed one reads as zero there). Such a lane is left to the scalar
-     * test instead of being rejected (test_leaf4 found a direction whose
-     * shear constant was subnormal, under qemu-arm). */
-    {
-        const float32x4_t lim = vdupq_n_f32(FLT_MIN);
-#define RC__LEAF4_SMALL3(a, b, c) vorrq_u32(vorrq_u32(vcaltq_f32(a, lim), vcaltq_f32(b, lim)), vcaltq_f32(c, lim))
-        const uint32x4_t inputs = vorrq_u32(
-            vorrq_u32(RC__LEAF4_SMALL3(ax, ay, az_), RC__LEAF4_SMALL3(bx, by, bz_)),
-            vorrq_u32(RC__LEAF4_SMALL3(cx, cy, cz_), vorrq_u32(RC__LEAF4_SMALL3(ox, oy, oz), RC__LEAF4_SMALL3(sx, sy, sy))));
-        const uint32x4_t shear = vorrq_u32(
-            vorrq_u32(RC__LEAF4_SMALL3(az, bz, cz), RC__LEAF4_SMALL3(vsubq_f32(ax, ox), vsubq_f32(ay, oy), vsubq_f32(bx, ox))),
-            vorrq_u32(RC__LEAF4_SMALL3(vsubq_f32(by, oy), vsubq_f32(cx, ox), vsubq_f32(cy, oy)),
-                      vorrq_u32(RC__LEAF4_SMALL3(vmulq_f32(sx, az), vmulq_f32(sy, az), vmulq_f32(sx, bz)),
-                                RC__LEAF4_SMALL3(vmulq_f32(sy, bz), vmulq_f32(sx, cz), vmulq_f32(sy, cz)))));
-        const uint32x4_t edges = vorrq_u32(
-            vorrq_u32(RC__LEAF4_SMALL3(Ax, Ay, Bx), RC__LEAF4_SMALL3(By, Cx, Cy)),
-            vorrq_u32(RC__LEAF4_SMALL3(CxBy, CyBx, AxCy), RC__LEAF4_SMALL3(AyCx, BxAy, ByAx)));
-#undef RC__LEAF4_SMALL3
-        o->redo = all & ~rc__v4_bits(vbicq_u32(rejected, vorrq_u32(inputs, vorrq_u32(shear, edges))));
-        o->hit = 0;
-    }
+    RC__V4_STORE(o->t, t);
+    RC__V4_STORE(o->V, V);
+    RC__V4_STORE(o->W, W);
+    RC__V4_STORE(o->det, det);
 #endif
 }
 #endif

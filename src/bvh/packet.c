@@ -493,9 +493,8 @@ static RC__FORCE_INLINE int leaf_lane_offer(packet_trav *T, const rc__mesh *mesh
     uint32_t cand = lo->hit | lo->redo;
     int shrunk = 0;
     while (cand) {
-        uint32_t c = 0;
+        const uint32_t c = lowest_lane(cand); /* a triangle slot here, not a lane */
         float t, u, v;
-        while (!((cand >> c) & 1u)) ++c;
         cand &= cand - 1u;
         if (!rc__leaf4_take(lo, c, &T->rays[lane], vt[c], known, flat, &t, &u, &v)) continue;
         if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
