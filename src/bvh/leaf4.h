@@ -19,7 +19,7 @@
 #include <emmintrin.h>
 #define RC__LEAF4_SSE2 1
 #elif defined(__ARM_NEON) && !defined(RC__WIDE_FORCE_SCALAR)
-#include <arm_neon.h>
+#include "bvh/neon_ops.h"
 #define RC__LEAF4_NEON 1
 #endif
 
@@ -126,13 +126,7 @@ typedef uint32x4_t rc__v4mask;
 #if defined(__aarch64__)
 #define RC__V4_DIV(a, b) vdivq_f32(a, b) /* 32-bit NEON has no division */
 #endif
-static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m)
-{
-    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
-    const uint32x4_t b = vandq_u32(m, vld1q_u32(bits));
-    const uint32x2_t s2 = vorr_u32(vget_low_u32(b), vget_high_u32(b));
-    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
-}
+static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return rc__neon_bits(m); }
 #endif
 
 /* The watertight test of one ray against a leaf's (up to) four triangles,

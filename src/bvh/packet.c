@@ -22,7 +22,7 @@
 #include <emmintrin.h>
 #define RC__PACKET_SSE2 1
 #elif defined(__ARM_NEON) && !defined(RC__PACKET_FORCE_SCALAR)
-#include <arm_neon.h>
+#include "bvh/neon_ops.h"
 #define RC__PACKET_NEON 1
 #endif
 
@@ -82,32 +82,17 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     const float32x4_t vnx = vdupq_n_f32(nx), vny = vdupq_n_f32(ny), vnz = vdupq_n_f32(nz);
     const float32x4_t vfx = vdupq_n_f32(fx), vfy = vdupq_n_f32(fy), vfz = vdupq_n_f32(fz);
     const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE);
-    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
-    const uint32x4_t vbits = vld1q_u32(bits);
     for (g = 0; g < GROUPS; ++g) {
         const float32x4_t ix = vld1q_f32(L->ix + 4 * g), iy = vld1q_f32(L->iy + 4 * g);
         const float32x4_t iz = vld1q_f32(L->iz + 4 * g);
-        float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(L->tmax + 4 * g), a;
-        uint32x4_t h;
-        /* "a > b ? a : b" (NEON's max would propagate a NaN) */
-        a = vmulq_f32(vnx, ix);
-        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-        a = vmulq_f32(vny, iy);
-        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-        a = vmulq_f32(vnz, iz);
-        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-        a = vmulq_f32(vfx, ix);
-        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-        a = vmulq_f32(vfy, iy);
-        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-        a = vmulq_f32(vfz, iz);
-        t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-        h = vcleq_f32(t0, vmulq_f32(t1, scale));
-        {
-            uint32x4_t m = vandq_u32(h, vbits);
-            uint32x2_t s2 = vorr_u32(vget_low_u32(m), vget_high_u32(m));
-            out |= (vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1)) << (4 * g);
-        }
+        /* SSE2's max and min: a NaN imposes nothing, as above */
+        float32x4_t t0 = rc__neon_max_sse(vmulq_f32(vnx, ix), vdupq_n_f32(0.0f));
+        float32x4_t t1 = rc__neon_min_sse(vmulq_f32(vfx, ix), vld1q_f32(L->tmax + 4 * g));
+        t0 = rc__neon_max_sse(vmulq_f32(vny, iy), t0);
+        t0 = rc__neon_max_sse(vmulq_f32(vnz, iz), t0);
+        t1 = rc__neon_min_sse(vmulq_f32(vfy, iy), t1);
+        t1 = rc__neon_min_sse(vmulq_f32(vfz, iz), t1);
+        out |= rc__neon_bits(vcleq_f32(t0, vmulq_f32(t1, scale))) << (4 * g);
     }
 #else
     {
@@ -161,11 +146,8 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     _mm_store_ps(tn, t0);
     return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
 #elif defined(RC__PACKET_NEON)
-    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
     float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(P->tmax);
     uint32_t k;
-    uint32x4_t h;
-    uint32x2_t s2;
     for (k = 0; k < 3; ++k) {
         const float32x4_t o = vdupq_n_f32(L->org[k]), lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
         const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), o);
@@ -174,13 +156,11 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
         const float32x4_t b = vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi));
         /* selects, as in box_mask: a NaN (0 * inf) imposes nothing, where
          * NEON's max and min would propagate it */
-        t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-        t1 = vbslq_f32(vcltq_f32(b, t1), b, t1);
+        t0 = rc__neon_max_sse(a, t0);
+        t1 = rc__neon_min_sse(b, t1);
     }
     vst1q_f32(tn, t0);
-    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
-    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
-    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+    return rc__neon_bits(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))));
 #else
     uint32_t c, k, out = 0;
     for (c = 0; c < 4; ++c) {

@@ -16,7 +16,7 @@
 #include <emmintrin.h>
 #define RC__WIDE_BOX_SSE2 1
 #elif defined(__ARM_NEON) && !defined(RC__WIDE_FORCE_SCALAR)
-#include <arm_neon.h>
+#include "bvh/neon_ops.h"
 #define RC__WIDE_BOX_NEON 1
 #endif
 
@@ -43,29 +43,17 @@ static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uin
     _mm_store_ps(tn, t0);
     return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
 #elif defined(RC__WIDE_BOX_NEON)
-    static const uint32_t bits[4] = {1u, 2u, 4u, 8u};
     const float32x4_t ox = vdupq_n_f32(org[0]), oy = vdupq_n_f32(org[1]), oz = vdupq_n_f32(org[2]);
     const float32x4_t ix = vdupq_n_f32(inv[0]), iy = vdupq_n_f32(inv[1]), iz = vdupq_n_f32(inv[2]);
-    float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(tmax), a;
-    uint32x4_t h;
-    uint32x2_t s2;
-    /* "a > b ? a : b" (NEON's max would let a NaN through) */
-    a = vmulq_f32(vsubq_f32(vld1q_f32(nx), ox), ix);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(ny), oy), iy);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(nz), oz), iz);
-    t0 = vbslq_f32(vcgtq_f32(a, t0), a, t0);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fx), ox), ix);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fy), oy), iy);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
-    a = vmulq_f32(vsubq_f32(vld1q_f32(fz), oz), iz);
-    t1 = vbslq_f32(vcltq_f32(a, t1), a, t1);
+    /* SSE2's max and min, so a NaN plane imposes nothing here either */
+    float32x4_t t0 = rc__neon_max_sse(vmulq_f32(vsubq_f32(vld1q_f32(nx), ox), ix), vdupq_n_f32(0.0f));
+    float32x4_t t1 = rc__neon_min_sse(vmulq_f32(vsubq_f32(vld1q_f32(fx), ox), ix), vdupq_n_f32(tmax));
+    t0 = rc__neon_max_sse(vmulq_f32(vsubq_f32(vld1q_f32(ny), oy), iy), t0);
+    t0 = rc__neon_max_sse(vmulq_f32(vsubq_f32(vld1q_f32(nz), oz), iz), t0);
+    t1 = rc__neon_min_sse(vmulq_f32(vsubq_f32(vld1q_f32(fy), oy), iy), t1);
+    t1 = rc__neon_min_sse(vmulq_f32(vsubq_f32(vld1q_f32(fz), oz), iz), t1);
     vst1q_f32(tn, t0);
-    h = vandq_u32(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))), vld1q_u32(bits));
-    s2 = vorr_u32(vget_low_u32(h), vget_high_u32(h));
-    return vget_lane_u32(s2, 0) | vget_lane_u32(s2, 1);
+    return rc__neon_bits(vcleq_f32(t0, vmulq_f32(t1, vdupq_n_f32(RC__SLAB_FAR_SCALE))));
 #else
     uint32_t mask = 0;
     int c;
