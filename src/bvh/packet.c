@@ -465,13 +465,13 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
 }
 
 /* Offers lane's hits among a leaf's triangles (first slot child, vertices
- * vt) as rc__leaf4_test found them in *lo; 1 when the lane's tmax shrank. */
-static RC__FORCE_INLINE int leaf_lane_offer(packet_trav *T, const rc__mesh *mesh, const float *vt[4][3],
-                                            uint32_t child, uint32_t lane, const rc__leaf4_out *lo, uint32_t *known,
-                                            uint32_t *flat, uint32_t geom, uint32_t inst)
+ * vt) as rc__leaf4_test found them in *lo; sets *shrunk when the lane's
+ * tmax shrank. */
+static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mesh, const float *vt[4][3],
+                                             uint32_t child, uint32_t lane, const rc__leaf4_out *lo, uint32_t *known,
+                                             uint32_t *flat, uint32_t geom, uint32_t inst, int *shrunk)
 {
     uint32_t cand = lo->hit | lo->redo;
-    int shrunk = 0;
     while (cand) {
         const uint32_t c = lowest_lane(cand); /* a triangle slot here, not a lane */
         float t, u, v;
@@ -480,9 +480,8 @@ static RC__FORCE_INLINE int leaf_lane_offer(packet_trav *T, const rc__mesh *mesh
         if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
         lane_set_tmax(&T->L, lane, t);
         T->found[lane] = 1;
-        shrunk = 1;
+        *shrunk = 1;
     }
-    return shrunk;
 }
 
 /* Handles T's current node or leaf and moves to the next entry. With
@@ -568,13 +567,13 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
                 rc__leaf4_out lo2;
                 m &= m - 1u;
                 rc__leaf4_test_soa_pair(&rays[lane], &rays[lane2], &soa, n_tri, &lo, &lo2);
-                shrunk |= leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst);
-                shrunk |= leaf_lane_offer(T, mesh, vt, child, lane2, &lo2, &known, &flat, geom, inst);
+                leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, &shrunk);
+                leaf_lane_offer(T, mesh, vt, child, lane2, &lo2, &known, &flat, geom, inst, &shrunk);
                 continue;
             }
 #endif
             rc__leaf4_test_soa(&rays[lane], &soa, n_tri, &lo);
-            shrunk |= leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst);
+            leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, &shrunk);
         }
         if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L); /* hits only shrink tmax: tighten the bound */
     }
