@@ -3,10 +3,13 @@
  * barycentrics, bit for bit, for coherent tiles, mixed-octant tiles, axis-
  * parallel rays, planar tiles (a direction component 0 in every lane) and
  * partial packets; so do packets taking turns
- * (rc__mesh_intersect_packets), whatever their number and mix. */
+ * (rc__mesh_intersect_packets), whatever their number and mix. On x86-64
+ * both builds of the traversal (baseline SSE2 and AVX2, packet.c) are run,
+ * not only the one the CPU selects. */
 #include <math.h>
 #include <string.h>
 
+#include "bvh/leaf4.h"
 #include "bvh/packet.h"
 #include "rc_test.h"
 #include "scene/scene.h"
@@ -111,18 +114,38 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
     return n;
 }
 
-static void test_packet_equals_single(void **state)
+typedef void (*packet_fn)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
+                          rc__hit *hits, int *found);
+typedef void (*packets_fn)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays, const uint32_t *n,
+                           uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found);
+
+/* A build of the traversal: the entry points, or one of the two x86-64
+ * builds behind them. */
+typedef struct packet_build {
+    const char *name;
+    packet_fn one;
+    packets_fn many;
+} packet_build;
+
+static const packet_build selected = {"selected by the CPU", rc__mesh_intersect_packet, rc__mesh_intersect_packets};
+#if defined(RC__PACKET_TWO_BUILDS)
+static const packet_build baseline = {"baseline SSE2", rc__mesh_intersect_packet_sse2,
+                                      rc__mesh_intersect_packets_sse2};
+static const packet_build avx2 = {"AVX2", rc__mesh_intersect_packet_avx2, rc__mesh_intersect_packets_avx2};
+#endif
+
+static void packet_equals_single(const packet_build *b)
 {
     test_map t;
     uint32_t tile, tiles = rct_quick() ? 300u : 3000u;
-    (void)state;
+    print_message("packets: %s build\n", b->name);
     map_open(&t);
     for (tile = 0; tile < tiles; ++tile) {
         rc__ray rays[RC__PACKET_SIZE];
         rc__hit hits[RC__PACKET_SIZE];
         int found[RC__PACKET_SIZE];
         const uint32_t n = make_tile(tile, rays, hits, found);
-        rc__mesh_intersect_packet(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+        b->one(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found);
         expect_single(t.mesh, rays, n, hits, found);
     }
     map_close(&t);
@@ -130,14 +153,14 @@ static void test_packet_equals_single(void **state)
 
 /* Groups of 1..RC__PACKETS_IN_FLIGHT packets taking turns (each group mixes
  * the tile kinds above, so some members fall back to the plain path). */
-static void test_packets_in_turns_equal_single(void **state)
+static void packets_in_turns_equal_single(const packet_build *b)
 {
     test_map t;
     static rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     uint32_t group, tile = 0, groups = rct_quick() ? 60u : 600u;
-    (void)state;
+    print_message("packets in turns: %s build\n", b->name);
     map_open(&t);
     for (group = 0; group < groups; ++group) {
         const uint32_t k = 1u + group % RC__PACKETS_IN_FLIGHT;
@@ -151,10 +174,42 @@ static void test_packets_in_turns_equal_single(void **state)
             ph[j] = hits[j];
             pf[j] = found[j];
         }
-        rc__mesh_intersect_packets(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf);
+        b->many(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf);
         for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j]);
     }
     map_close(&t);
+}
+
+static void test_packet_equals_single(void **state)
+{
+    (void)state;
+    packet_equals_single(&selected);
+}
+
+static void test_packets_in_turns_equal_single(void **state)
+{
+    (void)state;
+    packets_in_turns_equal_single(&selected);
+}
+
+/* Both x86-64 builds, whichever the CPU selects (the AVX2 one where it has
+ * AVX2). */
+static void test_both_builds_equal_single(void **state)
+{
+    (void)state;
+#if defined(RC__PACKET_TWO_BUILDS)
+    packet_equals_single(&baseline);
+    packets_in_turns_equal_single(&baseline);
+    if (!rc__leaf4_have_avx2()) {
+        print_message("no AVX2 on this CPU: its build is not run\n");
+        return;
+    }
+    packet_equals_single(&avx2);
+    packets_in_turns_equal_single(&avx2);
+#else
+    print_message("one build of the traversal on this target\n");
+    skip();
+#endif
 }
 
 /* Turns start above the threshold: RC__LARGE_MESH_BYTES, or an eighth of a
@@ -183,6 +238,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single),
                                        cmocka_unit_test(test_packets_in_turns_equal_single),
+                                       cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

@@ -142,15 +142,12 @@ typedef struct rc__leaf4_out {
 } rc__leaf4_out;
 
 #if defined(RC__LEAF4_SSE2) && defined(__x86_64__) && defined(__GNUC__) && !defined(RC__LEAF4_NO_AVX2)
-/* Two rays at once in 8-wide AVX2 lanes (leaf4_avx2.c), for packets on CPUs
- * that have it: rc__leaf4_test_soa for ra into *oa and rb into *ob, the same
- * outputs bit for bit. Call it only where rc__leaf4_have_avx2() is 1. */
+/* Two rays at once in 8-wide AVX2 lanes (leaf4_pair.h), for packets on CPUs
+ * that have AVX2. */
 #define RC__LEAF4_PAIR_AVX2 1
 /* a load and a bit test (libgcc's CPU model, filled at start-up; it counts
  * AVX2 only where the OS saves the wide registers): cheap enough per packet */
 static RC__FORCE_INLINE int rc__leaf4_have_avx2(void) { return __builtin_cpu_supports("avx2") ? 1 : 0; }
-void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb, const rc__leaf4_soa *s, uint32_t count,
-                             rc__leaf4_out *oa, rc__leaf4_out *ob);
 #endif
 
 #if defined(RC__LEAF4_SSE2) || (defined(RC__LEAF4_NEON) && defined(__aarch64__))
@@ -189,27 +186,6 @@ void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb, const rc__lea
 #define RC__VL_TINY(a) vcaltq_f32(a, vdupq_n_f32(FLT_MIN))
 #endif
 #include "bvh/leaf4_lanes.h"
-#undef RC__VL_NAME
-#undef RC__VL_ATTR
-#undef RC__VL_T
-#undef RC__VL_M
-#undef RC__VL_SET1
-#undef RC__VL_SUB
-#undef RC__VL_ADD
-#undef RC__VL_MUL
-#undef RC__VL_DIV
-#undef RC__VL_LT
-#undef RC__VL_GT
-#undef RC__VL_EQ
-#undef RC__VL_ORDERED
-#undef RC__VL_UNORDERED
-#undef RC__VL_OR
-#undef RC__VL_AND
-#undef RC__VL_ANDNOT
-#undef RC__VL_ABS
-#undef RC__VL_BITS
-#undef RC__VL_FILTER_ONLY
-#undef RC__VL_TINY
 
 /* Triangles i < count given their a, b, c coordinates along kx, ky, kz
  * (separate arguments, not an array: an array of vectors made gcc keep them

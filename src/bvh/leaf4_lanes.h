@@ -3,7 +3,8 @@
  * for eight (two rays in AVX2). No include guard: each includer defines
  * RC__VL_NAME (the function's name), RC__VL_ATTR (its attributes beyond
  * static inline), the types RC__VL_T (floats) and RC__VL_M (lane masks), and
- * the operations below, includes this file, and undefines them again.
+ * the operations below and includes this file, which undefines them all
+ * at its end.
  *
  *   SET1(x) SUB ADD MUL DIV          IEEE single precision, no contraction
  *   LT GT EQ(a, b)                   ordered compares, a mask per lane
@@ -109,3 +110,25 @@ static RC__FORCE_INLINE RC__VL_ATTR void RC__VL_NAME(RC__VL_T ax, RC__VL_T ay, R
     }
 #endif
 }
+
+#undef RC__VL_NAME
+#undef RC__VL_ATTR
+#undef RC__VL_T
+#undef RC__VL_M
+#undef RC__VL_SET1
+#undef RC__VL_SUB
+#undef RC__VL_ADD
+#undef RC__VL_MUL
+#undef RC__VL_DIV
+#undef RC__VL_LT
+#undef RC__VL_GT
+#undef RC__VL_EQ
+#undef RC__VL_ORDERED
+#undef RC__VL_UNORDERED
+#undef RC__VL_OR
+#undef RC__VL_AND
+#undef RC__VL_ANDNOT
+#undef RC__VL_ABS
+#undef RC__VL_BITS
+#undef RC__VL_FILTER_ONLY
+#undef RC__VL_TINY

@@ -18,9 +18,34 @@
 #include <float.h>
 #include <stddef.h>
 
+/* On x86-64 this file is compiled twice (RC__PACKET_TWO_BUILDS, packet.h):
+ * as itself for baseline x86-64 (the entry points named ..._sse2), and as
+ * packet_avx2.c with -mavx2 (..._avx2), where the box tests take eight lanes
+ * at a time and every leaf tests two lanes at once (leaf4_pair.h). The
+ * entry points without a suffix, at the end, choose by the CPU
+ * (rc__leaf4_have_avx2: a load and a bit test). Both builds run the same
+ * operations lane for lane, without fused multiply-add, so their answers
+ * are the same bit for bit. */
+#if defined(RC__PACKET_AVX2_VARIANT)
+#define RC__PACKET_FN(name) name##_avx2
+#elif defined(RC__PACKET_TWO_BUILDS)
+#define RC__PACKET_FN(name) name##_sse2
+#else
+#define RC__PACKET_FN(name) name
+#endif
+
 #if defined(__SSE2__) && !defined(RC__PACKET_FORCE_SCALAR)
 #include <emmintrin.h>
 #define RC__PACKET_SSE2 1
+#if defined(RC__PACKET_AVX2_VARIANT)
+#if !defined(__AVX2__) || !defined(RC__LEAF4_PAIR_AVX2) || !defined(RC__PACKET_TWO_BUILDS)
+#error "packet_avx2.c needs -mavx2 and an x86-64 GNU C compiler"
+#endif
+#include <immintrin.h>
+
+#include "bvh/leaf4_pair.h"
+#define RC__PACKET_AVX2 1
+#endif
 #elif defined(__ARM_NEON) && !defined(RC__PACKET_FORCE_SCALAR)
 #include "bvh/neon_ops.h"
 #define RC__PACKET_NEON 1
@@ -62,22 +87,51 @@ static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lan
     const float fz = n->box[L->near_row[2] ^ 1u][c] - L->org[2];
     uint32_t out = 0, g;
 #if defined(RC__PACKET_SSE2)
-    const __m128 vnx = _mm_set1_ps(nx), vny = _mm_set1_ps(ny), vnz = _mm_set1_ps(nz);
-    const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy), vfz = _mm_set1_ps(fz);
-    const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
-    for (g = 0; g < GROUPS; ++g) {
-        const __m128 ix = _mm_load_ps(L->ix + 4 * g), iy = _mm_load_ps(L->iy + 4 * g);
-        const __m128 iz = _mm_load_ps(L->iz + 4 * g);
+    /* x86: rows of BOX_W lanes (four in SSE2, eight in the AVX2 build), the
+     * same operations lane for lane either way */
+#if defined(RC__PACKET_AVX2)
+#define BOX_W 8u
+#define BOX_V __m256
+#define BOX_SET1(x) _mm256_set1_ps(x)
+#define BOX_LOAD(p) _mm256_loadu_ps(p)
+#define BOX_MUL(a, b) _mm256_mul_ps(a, b)
+#define BOX_MAX(a, b) _mm256_max_ps(a, b)
+#define BOX_MIN(a, b) _mm256_min_ps(a, b)
+#define BOX_LE_BITS(a, b) ((uint32_t)_mm256_movemask_ps(_mm256_cmp_ps(a, b, _CMP_LE_OS)))
+#else
+#define BOX_W 4u
+#define BOX_V __m128
+#define BOX_SET1(x) _mm_set1_ps(x)
+#define BOX_LOAD(p) _mm_load_ps(p)
+#define BOX_MUL(a, b) _mm_mul_ps(a, b)
+#define BOX_MAX(a, b) _mm_max_ps(a, b)
+#define BOX_MIN(a, b) _mm_min_ps(a, b)
+#define BOX_LE_BITS(a, b) ((uint32_t)_mm_movemask_ps(_mm_cmple_ps(a, b)))
+#endif
+    const BOX_V vnx = BOX_SET1(nx), vny = BOX_SET1(ny), vnz = BOX_SET1(nz);
+    const BOX_V vfx = BOX_SET1(fx), vfy = BOX_SET1(fy), vfz = BOX_SET1(fz);
+    const BOX_V scale = BOX_SET1(RC__SLAB_FAR_SCALE);
+    for (g = 0; g < LANES / BOX_W; ++g) {
+        const BOX_V ix = BOX_LOAD(L->ix + BOX_W * g), iy = BOX_LOAD(L->iy + BOX_W * g);
+        const BOX_V iz = BOX_LOAD(L->iz + BOX_W * g);
         /* max/min return their second operand when the first is NaN: a NaN
          * (0 * inf, origin on a plane of a parallel ray) imposes nothing */
-        __m128 t0 = _mm_max_ps(_mm_mul_ps(vnx, ix), _mm_setzero_ps());
-        __m128 t1 = _mm_min_ps(_mm_mul_ps(vfx, ix), _mm_load_ps(L->tmax + 4 * g));
-        t0 = _mm_max_ps(_mm_mul_ps(vny, iy), t0);
-        t0 = _mm_max_ps(_mm_mul_ps(vnz, iz), t0);
-        t1 = _mm_min_ps(_mm_mul_ps(vfy, iy), t1);
-        t1 = _mm_min_ps(_mm_mul_ps(vfz, iz), t1);
-        out |= (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, scale))) << (4 * g);
+        BOX_V t0 = BOX_MAX(BOX_MUL(vnx, ix), BOX_SET1(0.0f));
+        BOX_V t1 = BOX_MIN(BOX_MUL(vfx, ix), BOX_LOAD(L->tmax + BOX_W * g));
+        t0 = BOX_MAX(BOX_MUL(vny, iy), t0);
+        t0 = BOX_MAX(BOX_MUL(vnz, iz), t0);
+        t1 = BOX_MIN(BOX_MUL(vfy, iy), t1);
+        t1 = BOX_MIN(BOX_MUL(vfz, iz), t1);
+        out |= BOX_LE_BITS(t0, BOX_MUL(t1, scale)) << (BOX_W * g);
     }
+#undef BOX_W
+#undef BOX_V
+#undef BOX_SET1
+#undef BOX_LOAD
+#undef BOX_MUL
+#undef BOX_MAX
+#undef BOX_MIN
+#undef BOX_LE_BITS
 #elif defined(RC__PACKET_NEON)
     const float32x4_t vnx = vdupq_n_f32(nx), vny = vdupq_n_f32(ny), vnz = vdupq_n_f32(nz);
     const float32x4_t vfx = vdupq_n_f32(fx), vfy = vdupq_n_f32(fy), vfz = vdupq_n_f32(fz);
@@ -318,7 +372,7 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
         if (m == 1) {
             sub_found[0] = rc__mesh_intersect(mesh, &sub[0], geom, inst, &sub_hits[0]);
         } else {
-            rc__mesh_intersect_packet(mesh, sub, m, geom, inst, sub_hits, sub_found);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found);
         }
         for (i = 0; i < m; ++i) {
             hits[idx[i]] = sub_hits[i];
@@ -340,7 +394,6 @@ typedef struct packet_trav {
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
-    int avx2;          /* leaves test two lanes at once (rc__leaf4_have_avx2) */
     /* up to three pushes per level */
     packet_entry stack[PACKET_STACK];
 } packet_trav;
@@ -456,11 +509,6 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
     T->child = 0;
     T->count = 0;
     T->staged = T->settling = 0;
-#if defined(RC__LEAF4_PAIR_AVX2)
-    T->avx2 = rc__leaf4_have_avx2();
-#else
-    T->avx2 = 0;
-#endif
     return 1;
 }
 
@@ -556,7 +604,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     } else {
         /* lane by lane: the leaf's four triangles (transposed once for all
          * lanes) through the SIMD watertight test (leaf4.h); two lanes at a
-         * time where the CPU has AVX2 */
+         * time in the AVX2 build */
         const rc__ray *rays = T->rays;
         const float *vt[4][3];
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
@@ -568,8 +616,8 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         while (m) {
             const uint32_t lane = lowest_lane(m);
             m &= m - 1u;
-#if defined(RC__LEAF4_PAIR_AVX2)
-            if (m && T->avx2) {
+#if defined(RC__PACKET_AVX2)
+            if (m) {
                 const uint32_t lane2 = lowest_lane(m);
                 rc__leaf4_out lo2;
                 m &= m - 1u;
@@ -615,8 +663,8 @@ next:
     return 1;
 }
 
-void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                               uint32_t inst, rc__hit *hits, int *found)
+void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
+                                              uint32_t inst, rc__hit *hits, int *found)
 {
     packet_trav T;
     uint32_t i;
@@ -634,22 +682,22 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
     }
 }
 
-void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
-                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                int *const *found)
+void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
+                                               const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
+                                               int *const *found)
 {
     packet_trav T[RC__PACKETS_IN_FLIGHT];
     uint32_t live = 0, k;
     if (packets > RC__PACKETS_IN_FLIGHT) packets = RC__PACKETS_IN_FLIGHT;
     if (packets == 1) {
-        rc__mesh_intersect_packet(mesh, rays[0], n[0], geom, inst, hits[0], found[0]);
+        RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0]);
         return;
     }
     for (k = 0; k < packets; ++k) {
         if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k]))
             live |= 1u << k;
         else
-            rc__mesh_intersect_packet(mesh, rays[k], n[k], geom, inst, hits[k], found[k]);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k]);
     }
     /* take turns: while one packet's next node or leaf is on its way from
      * memory, the others work */
@@ -658,3 +706,24 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
             if (((live >> k) & 1u) && !trav_step(&T[k], mesh, geom, inst, 1)) live &= ~(1u << k);
     }
 }
+
+#if defined(RC__PACKET_TWO_BUILDS) && !defined(RC__PACKET_AVX2_VARIANT)
+void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
+                               uint32_t inst, rc__hit *hits, int *found)
+{
+    if (rc__leaf4_have_avx2())
+        rc__mesh_intersect_packet_avx2(mesh, rays, n, geom, inst, hits, found);
+    else
+        rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found);
+}
+
+void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
+                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
+                                int *const *found)
+{
+    if (rc__leaf4_have_avx2())
+        rc__mesh_intersect_packets_avx2(mesh, packets, rays, n, geom, inst, hits, found);
+    else
+        rc__mesh_intersect_packets_sse2(mesh, packets, rays, n, geom, inst, hits, found);
+}
+#endif

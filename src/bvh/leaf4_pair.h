@@ -1,11 +1,15 @@
 /* Two rays of a packet against a leaf's four triangles in one pass of 8-wide
- * AVX2 lanes (lanes 0-3: the first ray, 4-7: the second), on x86-64 CPUs
- * that have AVX2 (checked at run time: the library is built for baseline
- * x86-64). Both halves run the lane body the 4-wide test runs
- * (leaf4_lanes.h), in IEEE single precision with no fused multiply-add (the
- * target does not enable FMA), so each ray gets the rc__leaf4_out that SSE2
- * gives it, bit for bit. A packet's leaf is met by eleven lanes on average
- * on a 1k map, where these tests are the bulk of the work. */
+ * AVX2 lanes (lanes 0-3: the first ray, 4-7: the second), for the AVX2
+ * build of the packet traversal (packet_avx2.c), which inlines it. Both
+ * halves run the lane body the 4-wide test runs (leaf4_lanes.h), in IEEE
+ * single precision with no fused multiply-add (the function's target does
+ * not enable FMA), so each ray gets the rc__leaf4_out that SSE2 gives it,
+ * bit for bit. Call it only where rc__leaf4_have_avx2() is 1. A packet's
+ * leaf is met by eleven lanes on average on a 1k map, where these tests are
+ * the bulk of the work. */
+#ifndef RC_BVH_LEAF4_PAIR_H
+#define RC_BVH_LEAF4_PAIR_H
+
 #include "bvh/leaf4.h"
 
 #if defined(RC__LEAF4_PAIR_AVX2)
@@ -37,9 +41,10 @@
 #define PAIR_ROW(lo, hi) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1)
 #define PAIR_SET(a, b) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(a)), _mm_set1_ps(b), 1)
 
-__attribute__((target("avx2"))) void rc__leaf4_test_soa_pair(const rc__ray *ra, const rc__ray *rb,
-                                                              const rc__leaf4_soa *s, uint32_t count,
-                                                              rc__leaf4_out *oa, rc__leaf4_out *ob)
+/* rc__leaf4_test_soa for ra into *oa and rb into *ob */
+static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_pair(
+    const rc__ray *ra, const rc__ray *rb, const rc__leaf4_soa *s, uint32_t count, rc__leaf4_out *oa,
+    rc__leaf4_out *ob)
 {
     const uint32_t all4 = (1u << count) - 1u;
     __m256 t, V, W, det;
@@ -65,7 +70,8 @@ __attribute__((target("avx2"))) void rc__leaf4_test_soa_pair(const rc__ray *ra, 
     _mm_storeu_ps(oa->det, _mm256_castps256_ps128(det));
     _mm_storeu_ps(ob->det, _mm256_extractf128_ps(det, 1));
 }
-#else
-/* ISO C wants a declaration in every translation unit */
-typedef int rc__leaf4_avx2_unused;
+#undef PAIR_ROW
+#undef PAIR_SET
+#endif
+
 #endif
