@@ -118,11 +118,16 @@ static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, flo
 #else
 #define RC__FORCE_INLINE inline __attribute__((always_inline))
 #endif
+/* Helpers that only prefetch are inlined even at -Os: gcc 12 finds such a
+ * helper free of side effects and deletes its calls before inlining it (at
+ * -Os the turns and the push prefetch fetched nothing). */
+#define RC__PREFETCH_INLINE inline __attribute__((always_inline))
 #define RC__ALIGN16 __attribute__((aligned(16)))
 #define RC__PREFETCH(p) __builtin_prefetch(p)
 #else
 #define RC__COLD static inline
 #define RC__FORCE_INLINE inline
+#define RC__PREFETCH_INLINE inline
 #define RC__ALIGN16
 #define RC__PREFETCH(p) ((void)(p))
 #endif

@@ -43,8 +43,8 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, c
 /* For traversals taking turns: the first bytes of what a ray or packet
  * visits next (count 0: wide node `child`, both its cache lines; else the
  * leaf's index triples), and, once those are in, a leaf's vertices. */
-static RC__FORCE_INLINE void rc__prefetch_next(const rc__wnode *nodes, const uint32_t *leaf_tris, uint32_t child,
-                                              uint32_t count)
+static RC__PREFETCH_INLINE void rc__prefetch_next(const rc__wnode *nodes, const uint32_t *leaf_tris, uint32_t child,
+                                                 uint32_t count)
 {
     if (count == 0) {
         const char *p = (const char *)&nodes[child];
@@ -55,7 +55,7 @@ static RC__FORCE_INLINE void rc__prefetch_next(const rc__wnode *nodes, const uin
     }
 }
 
-static RC__FORCE_INLINE void rc__leaf4_prefetch_vertices(const float *const v[4][3], uint32_t count)
+static RC__PREFETCH_INLINE void rc__leaf4_prefetch_vertices(const float *const v[4][3], uint32_t count)
 {
     uint32_t i;
     for (i = 0; i < count; ++i) {
