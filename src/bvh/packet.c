@@ -38,7 +38,7 @@
 #include <emmintrin.h>
 #define RC__PACKET_SSE2 1
 #if defined(RC__PACKET_AVX2_VARIANT)
-#if !defined(__AVX2__) || !defined(RC__LEAF4_PAIR_AVX2) || !defined(RC__PACKET_TWO_BUILDS)
+#if !defined(__AVX2__) || !defined(RC__PACKET_TWO_BUILDS)
 #error "packet_avx2.c needs -mavx2 and an x86-64 GNU C compiler"
 #endif
 #include <immintrin.h>

@@ -8,6 +8,7 @@
 #ifndef RC_BVH_PACKET_H
 #define RC_BVH_PACKET_H
 
+#include "bvh/leaf4.h"
 #include "bvh/mesh.h"
 
 #define RC__PACKET_SIZE 16u
@@ -27,13 +28,11 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
                                 int *const *found);
 
-/* On x86-64 with GNU C the traversal is built twice (packet.c): for
- * baseline x86-64 and for AVX2. The functions above choose by the CPU; these
- * are the two builds, for tests (call the _avx2 ones only where
- * rc__leaf4_have_avx2() is 1). The condition matches leaf4.h's for its AVX2
- * pairs and packet.c's for SSE2. */
-#if defined(__x86_64__) && defined(__GNUC__) && defined(__SSE2__) && !defined(RC__LEAF4_NO_AVX2) && \
-    !defined(RC__WIDE_FORCE_SCALAR) && !defined(RC__PACKET_FORCE_SCALAR)
+/* Where leaf4.h has its AVX2 pairs (x86-64, GNU C) the traversal is built
+ * twice (packet.c): for baseline x86-64 and for AVX2. The functions above
+ * choose by the CPU; these are the two builds, for tests (call the _avx2
+ * ones only where rc__leaf4_have_avx2() is 1). */
+#if defined(RC__LEAF4_PAIR_AVX2) && !defined(RC__PACKET_FORCE_SCALAR)
 #define RC__PACKET_TWO_BUILDS 1
 void rc__mesh_intersect_packet_sse2(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
                                     uint32_t inst, rc__hit *hits, int *found);
