@@ -638,6 +638,119 @@ static void test_far_from_origin(void **state)
     rcu_mesh_free(&m);
 }
 
+/* A triangle whose vertices move between collinear (zero area: never hit)
+ * and whole, through rc_scene_update_mesh and commits: rays aimed along the
+ * collinear segment read the wall behind it, rays aimed inside the whole
+ * triangle read the triangle. The built-in backend keeps its leaves' zero-area
+ * triangles folded to (a, a, a) (bvh/mesh.h: flats_folded) and must unfold
+ * and fold again on every refit; a baked copy of the collinear state reads
+ * the same bits. */
+static void zero_area_scan(rc_context *ctx, rc_scene *scene, rc_sensor *sensor, const float *dirs, uint32_t n,
+                           int whole, float *ranges_out)
+{
+    rct_buffers buf;
+    rc_pose pose = rct_pose(0.0f, 0.0f, 0.0f);
+    uint32_t i;
+    rct_buffers_alloc(&buf, n, RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_PRIM_IDS);
+    RCT_OK(ctx, rc_simulate(ctx, scene, sensor, &pose, 1, &buf.res));
+    for (i = 0; i < n; ++i) {
+        const double len = sqrt((double)dirs[3 * i] * dirs[3 * i] + (double)dirs[3 * i + 1] * dirs[3 * i + 1] +
+                                (double)dirs[3 * i + 2] * dirs[3 * i + 2]);
+        /* rays 0..15 aim inside the whole triangle, 16..31 at the collinear
+         * segment (an edge of the whole triangle: either answer there), the
+         * rest at the wall; the triangle is at x = 5, the wall at x = 10 */
+        const int on_triangle = whole && (i < 16u || (i < 32u && buf.res.prim_ids[i] == 2u));
+        const double expect = (on_triangle ? 5.0 : 10.0) * len / dirs[3 * i];
+        assert_int_equal(buf.res.hits[i], 1);
+        if (fabs(buf.res.ranges[i] - expect) > 1e-5 * expect || (buf.res.prim_ids[i] == 2u) != on_triangle)
+            fail_msg("%s, ray %u: range %.7f prim %u, expected %.7f on the %s", whole ? "whole" : "collinear", i,
+                     (double)buf.res.ranges[i], (unsigned)buf.res.prim_ids[i], expect,
+                     on_triangle ? "triangle" : "wall");
+        if (ranges_out) ranges_out[i] = buf.res.ranges[i];
+    }
+    rct_buffers_free(&buf);
+}
+
+static void test_zero_area_updates(void **state)
+{
+    enum { RAYS = 64 };
+    uint32_t b = backend_of(state);
+    /* wall x = 10 (two triangles), then a, b, c at x = 5 with c = a + 2 (b - a) */
+    static const float wall_and_segment[3 * 7] = {10.0f, -50.0f, -50.0f, 10.0f, 50.0f, -50.0f, 10.0f, 50.0f, 50.0f,
+                                                  10.0f, -50.0f, 50.0f, 5.0f,  -1.0f, -0.5f, 5.0f,  0.0f,
+                                                  0.0f,  5.0f,  1.0f,  0.5f};
+    static const uint32_t tris[9] = {0, 1, 2, 0, 2, 3, 4, 5, 6};
+    const float whole_c[3] = {5.0f, 1.0f, -2.0f};
+    rc_context *ctx;
+    rc_scene *scene;
+    rc_sensor *sensor;
+    rcu_mesh m;
+    float dirs[3 * RAYS], live[RAYS];
+    uint32_t i, round;
+    NEED_BACKEND(b);
+    ctx = rct_context(b, 2, 0);
+    m.vertex_count = 7;
+    m.triangle_count = 3;
+    m.vertices = (float *)malloc(sizeof wall_and_segment);
+    m.indices = (uint32_t *)malloc(sizeof tris);
+    assert_non_null(m.vertices);
+    assert_non_null(m.indices);
+    memcpy(m.vertices, wall_and_segment, sizeof wall_and_segment);
+    memcpy(m.indices, tris, sizeof tris);
+    /* rays 0..15: a + s (b - a) + w (c' - b), inside a, b, c' (s > w > 0);
+     * 16..31: a + s (c - a), on the collinear segment (exact in float);
+     * 32..63: the wall away from both */
+    for (i = 0; i < 16u; ++i) {
+        const float s = 0.1f + 0.8f * (float)(i / 2u) / 7.0f, w = (i & 1u) ? 0.05f : 0.02f;
+        dirs[3 * i] = 5.0f;
+        dirs[3 * i + 1] = -1.0f + s + w;
+        dirs[3 * i + 2] = -0.5f + s * 0.5f - 2.0f * w;
+    }
+    for (; i < 32u; ++i) {
+        const float s = (float)(i - 16u) / 8.0f; /* 0, 1/8 ... 15/8 of b - a */
+        dirs[3 * i] = 5.0f;
+        dirs[3 * i + 1] = -1.0f + s;
+        dirs[3 * i + 2] = -0.5f + 0.5f * s;
+    }
+    for (; i < RAYS; ++i) {
+        dirs[3 * i] = 5.0f;
+        dirs[3 * i + 1] = 2.0f + 0.05f * (float)(i - RAYS / 2);
+        dirs[3 * i + 2] = 1.5f;
+    }
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    sensor = rct_sensor_dirs(ctx, dirs, RAYS, 0.1f, 100.0f);
+    zero_area_scan(ctx, scene, sensor, dirs, RAYS, 0, NULL);
+    for (round = 0; round < 2; ++round) {
+        memcpy(m.vertices + 3 * 6, whole_c, sizeof whole_c);
+        RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+        RCT_OK(ctx, rc_scene_commit(scene));
+        zero_area_scan(ctx, scene, sensor, dirs, RAYS, 1, NULL);
+        memcpy(m.vertices + 3 * 6, wall_and_segment + 3 * 6, 3 * sizeof(float));
+        RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+        RCT_OK(ctx, rc_scene_commit(scene));
+        zero_area_scan(ctx, scene, sensor, dirs, RAYS, 0, live);
+    }
+    if (b == RC_BACKEND_BVH) {
+        /* baked: the file keeps whole triples; the loaded map checks areas */
+        size_t need = 0, n = 0;
+        void *blob;
+        rc_scene *loaded = NULL;
+        float baked[RAYS];
+        RCT_OK(ctx, rc_scene_bake(scene, NULL, 0, &need));
+        blob = rct_alloc16(need);
+        RCT_OK(ctx, rc_scene_bake(scene, blob, need, &n));
+        RCT_OK(ctx, rc_scene_load_baked(ctx, blob, n, 0, &loaded));
+        zero_area_scan(ctx, loaded, sensor, dirs, RAYS, 0, baked);
+        assert_memory_equal(baked, live, sizeof live);
+        rc_scene_destroy(loaded);
+        free(blob);
+    }
+    rc_sensor_destroy(sensor);
+    rc_scene_destroy(scene);
+    rcu_mesh_free(&m);
+    rc_context_destroy(ctx);
+}
+
 #define FOR_BACKENDS(f)                                            \
     cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),        \
         cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),    \
@@ -651,7 +764,7 @@ int main(void)
         FOR_BACKENDS(test_instances),         FOR_BACKENDS(test_watertight),
         FOR_BACKENDS(test_thread_independence), FOR_BACKENDS(test_only_requested_attributes),
         FOR_BACKENDS(test_coplanar_tie),      FOR_BACKENDS(test_pinhole_wall),
-        FOR_BACKENDS(test_far_from_origin),
+        FOR_BACKENDS(test_far_from_origin),   FOR_BACKENDS(test_zero_area_updates),
     };
     return cmocka_run_group_tests_name("scenes (every backend)", tests, NULL, NULL);
 }

@@ -262,11 +262,17 @@ static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf
  * rc__tri_intersect gives them when it is hit, else 0. tv: its vertices.
  * The zero-area check depends on the triangle alone: *known and *flat keep
  * its answers per slot (bit c), so a leaf that a packet's lanes test in
- * turn runs it once per triangle (1k sphere: 4% of the time, once a lane). */
+ * turn runs it once per triangle (1k sphere: 4% of the time, once a lane).
+ * Callers start *known at 0xF for a mesh whose flats_folded is set: there a
+ * zero-area triangle is (a, a, a), which the lanes never report as a hit
+ * (zero edge functions: a redo, which ends at the vertex compare below). */
 static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, const rc__ray *r,
                                           const float *const tv[3], uint32_t *known, uint32_t *flat, float *t,
                                           float *u, float *v)
 {
+    /* two vertices the same (a folded zero-area triangle, (a, a, a), lands
+     * here every time: its edge functions are all exactly 0): never a hit */
+    if (tv[0] == tv[1]) return 0;
 #if defined(RC__LEAF4_FULL)
     if ((o->redo >> c) & 1u) return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, u, v);
     if (!((*known >> c) & 1u)) {

@@ -7,6 +7,7 @@
 #include "core/common.h"
 
 #include <math.h>
+#include <string.h>
 
 void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3])
 {
@@ -64,6 +65,24 @@ void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out)
             out[i].max[k] = hi;
         }
     }
+}
+
+void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out)
+{
+    uint32_t j;
+    for (j = 0; j < mesh->triangle_count; ++j)
+        memcpy(out + (size_t)3 * j, mesh->indices + (size_t)3 * mesh->bvh.refs[j], 3 * sizeof(uint32_t));
+}
+
+uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
+{
+    uint32_t j;
+    for (j = 0; j < mesh->triangle_count; ++j) {
+        uint32_t *t = leaf_tris + (size_t)3 * j;
+        if (rc__tri_zero_area(rc__vertex(mesh, t[0]), rc__vertex(mesh, t[1]), rc__vertex(mesh, t[2])))
+            t[1] = t[2] = t[0];
+    }
+    return 1u;
 }
 
 void rc__mesh_triangle_normal(const rc__mesh *mesh, uint32_t prim, float n[3])

@@ -25,7 +25,11 @@ typedef struct rc__mesh {
      * which is then in bvh.nodes). Its leaves index bvh.refs and leaf_tris. */
     const rc__wnode *wide;
     uint32_t wide_count;
-    uint32_t reserved1;
+    /* 1 when leaf_tris holds every zero-area triangle as (a, a, a)
+     * (rc__mesh_fold_flats), which no test ever hits: the leaf tests then
+     * skip the per-hit zero-area check. 0 (a test's own triples, a baked map
+     * with a zero-area triangle) keeps it. */
+    uint32_t flats_folded;
 } rc__mesh;
 
 /* A ray prepared for traversal: origin, direction (any length, not zero),
@@ -56,6 +60,14 @@ void rc__ray_prepare(rc__ray *ray, const float org[3], const float dir[3]);
  * SSE2 (ray_batch.c). */
 void rc__rays_prepare_turned(const float r[9], const float org[3], const float *dirs, const uint32_t *idx,
                              uint32_t n, rc__ray *rays);
+
+/* Fills out (3 per slot, leaf order) with the vertex indices of triangle
+ * refs[slot]. */
+void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out);
+/* Rewrites every zero-area triangle (rc__tri_zero_area) of those triples as
+ * (a, a, a), in place; returns 1, the value for flats_folded once they are
+ * the mesh's leaf_tris. Boxes are computed from the triples before this. */
+uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris);
 
 /* Item bounds of every triangle (for the builder). */
 void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);

@@ -610,7 +610,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
         rc__leaf4_soa soa RC__ALIGN16;
         rc__leaf4_out lo;
-        uint32_t m = mask, known = 0, flat = 0;
+        uint32_t m = mask, known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
         int shrunk = 0;
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
         while (m) {

@@ -84,6 +84,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
     const rc__wnode *nodes = mesh->wide;
     const uint32_t *refs = mesh->bvh.refs;
     const uint32_t *leaf_tris = mesh->leaf_tris;
+    const uint32_t flats_known = mesh->flats_folded ? 0xFu : 0u; /* leaf4.h: rc__leaf4_take */
     const float *vertices = mesh->vertices;
     const size_t stride = mesh->stride;
     const rc__ray r = *ray;
@@ -132,7 +133,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
         } else {
             const float *vt[4][3];
             rc__leaf4_out lo;
-            uint32_t cand, known = 0, flat = 0;
+            uint32_t cand, known = flats_known, flat = 0;
             count = rc__leaf4_vertices(leaf_tris, vertices, stride, child, count, vt);
             rc__leaf4_test(&r, (const float *const(*)[3])vt, count, &lo);
             cand = lo.hit | lo.redo;
@@ -242,7 +243,7 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
         const float *vt[4][3];
         const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
         rc__leaf4_out lo;
-        uint32_t cand, known = 0, flat = 0;
+        uint32_t cand, known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
         rc__leaf4_test(&T->r, (const float *const(*)[3])vt, count, &lo);
         cand = lo.hit | lo.redo;
         while (cand) {

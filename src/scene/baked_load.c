@@ -15,6 +15,7 @@
  *     none left over, no deeper than a build makes.
  * Traversal stacks still drop entries past their size instead of
  * overflowing (wide_trace.c, packet.c). */
+#include "bvh/intersect.h"
 #include "scene/baked_format.h"
 #include "scene/scene.h"
 
@@ -217,6 +218,23 @@ static rc_status check_tree_order(rc_context *ctx, uint32_t g, const rc__baked_g
     return RC_OK;
 }
 
+/* The mesh's flats_folded (bvh/mesh.h) for a file's triples, which are
+ * whole (as the mesh's indices): 1 when no triangle has zero area but those
+ * with a repeated index, which the leaf tests never hit (an edge function
+ * exactly 0 sends them to the scalar test, which checks the area). */
+static uint32_t flats_folded(const rc__baked_geom *r, const float *v, const uint32_t *lt)
+{
+    uint32_t i;
+    for (i = 0; i < r->triangles; ++i) {
+        const uint32_t *t = lt + 3u * (size_t)i;
+        if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+        if (rc__tri_zero_area(v + (size_t)t[0] * RC__BAKED_VERTEX_FLOATS, v + (size_t)t[1] * RC__BAKED_VERTEX_FLOATS,
+                              v + (size_t)t[2] * RC__BAKED_VERTEX_FLOATS))
+            return 0;
+    }
+    return 1;
+}
+
 static rc_status check_geometry(rc_context *ctx, const unsigned char *blob, uint32_t g, const rc__baked_geom *r)
 {
     const float *v = (const float *)(const void *)(blob + r->off_vertices);
@@ -284,6 +302,7 @@ rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_
             m->leaf_tris = (const uint32_t *)(const void *)(blob + r.off_leaf_tris);
             m->wide = (const rc__wnode *)(const void *)(blob + r.off_nodes);
             m->wide_count = r.nodes;
+            m->flats_folded = flats_folded(&r, m->vertices, m->leaf_tris);
             geo->baked = 1;
             geo->dirty = 0;
         } else {

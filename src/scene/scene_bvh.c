@@ -211,6 +211,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
         rc__geometry *geo = &scene->geoms[g];
         rc__mesh *mesh = &geo->mesh;
         uint32_t n = rc__bvh_node_count(mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE);
+        uint32_t *lt = leaf_tris + 3u * ref_off;
         if (geo->baked) continue; /* a baked map's tree, in place; the block reserved nothing for it */
         if (geo->dirty == 1) {
             mesh->bvh.nodes = wide ? scratch_nodes : nodes + node_off;
@@ -218,12 +219,9 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             rc__mesh_triangle_bounds(mesh, item_bounds);
             rc__bvh_build_mt(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
                              ctx->pool, progress, user);
-            {
-                uint32_t *lt = leaf_tris + 3u * ref_off, j;
-                for (j = 0; j < mesh->triangle_count; ++j)
-                    memcpy(lt + 3u * j, mesh->indices + 3u * (size_t)mesh->bvh.refs[j], 3 * sizeof(uint32_t));
-                mesh->leaf_tris = lt;
-            }
+            rc__mesh_fill_leaf_tris(mesh, lt);
+            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
+            mesh->leaf_tris = lt;
             if (wide) {
                 mesh->wide = wnodes + wide_off;
                 mesh->wide_count = rc__wide_collapse(&mesh->bvh, wnodes + wide_off);
@@ -232,13 +230,16 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
                 mesh->bvh.node_count = 0;
             }
         } else if (geo->dirty == 2) {
+            /* moved vertices can make a zero-area triangle whole (or the
+             * reverse): boxes from the whole triples, then fold again */
+            rc__mesh_fill_leaf_tris(mesh, lt);
             if (wide) {
-                rc__wide_refit((rc__wnode *)(uintptr_t)mesh->wide, mesh->wide_count, mesh->leaf_tris, mesh->vertices,
-                               mesh->stride);
+                rc__wide_refit((rc__wnode *)(uintptr_t)mesh->wide, mesh->wide_count, lt, mesh->vertices, mesh->stride);
             } else {
                 rc__mesh_triangle_bounds(mesh, item_bounds);
                 rc__bvh_refit(&mesh->bvh, item_bounds);
             }
+            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
         }
         geo->dirty = 0;
         node_off += n + (n & 1u); /* the next mesh starts at an even index */
