@@ -26,7 +26,6 @@ static double uniform(void)
 static void hit_init(rc__hit *h)
 {
     h->t = 1000.0f;
-    h->u = h->v = 0.0f;
     h->prim = h->geom = h->inst = h->slot = RC_INVALID_ID;
 }
 
@@ -43,8 +42,6 @@ static void expect_single(const rc__mesh *mesh, const rc__ray *rays, uint32_t n,
         if (!fs) continue;
         assert_int_equal(hp[i].prim, hs.prim);
         assert_memory_equal(&hp[i].t, &hs.t, sizeof(float));
-        assert_memory_equal(&hp[i].u, &hs.u, sizeof(float));
-        assert_memory_equal(&hp[i].v, &hs.v, sizeof(float));
     }
 }
 

@@ -37,7 +37,6 @@ static double uniform(void) { return rcu_rng_uniform(&rng); }
 static void hit_init(rc__hit *h)
 {
     h->t = 1e30f; /* t is in units of |dir|, some directions are short */
-    h->u = h->v = 0.0f;
     h->prim = h->geom = h->inst = RC_INVALID_ID;
 }
 
@@ -47,8 +46,6 @@ static void same_hit(int fa, const rc__hit *a, int fb, const rc__hit *b)
     if (!fa) return;
     assert_int_equal(a->prim, b->prim);
     assert_memory_equal(&a->t, &b->t, sizeof(float));
-    assert_memory_equal(&a->u, &b->u, sizeof(float));
-    assert_memory_equal(&a->v, &b->v, sizeof(float));
 }
 
 static void test_scalar_equals_simd(void **state)

@@ -43,7 +43,6 @@ static uint32_t expected_prim(const rc_scene *scene, const rc_sensor *s, uint32_
     }
     rc__ray_prepare(&r, org, dir);
     h.t = RANGE_MAX;
-    h.u = h.v = 0.0f;
     h.prim = h.geom = h.inst = h.slot = RC_INVALID_ID;
     *geom = *inst = RC_INVALID_ID;
     if (!rc__scene_intersect(scene, &r, &h) || h.t < RANGE_MIN) return RC_INVALID_ID;

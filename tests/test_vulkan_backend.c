@@ -166,7 +166,6 @@ static void test_packed_arrays(void **state)
         if (i % 100 == 0) d[i / 100 % 3] = 0.0f; /* axis-parallel components */
         rc__ray_prepare(&ray, o, d);
         a.t = b.t = 100.0f;
-        a.u = a.v = b.u = b.v = 0.0f;
         a.prim = a.geom = a.inst = b.prim = b.geom = b.inst = RC_INVALID_ID;
         fa = rc__scene_intersect(s.world, &ray, &a);
         fb = rc__vk_packed_intersect(&p, &ray, &b);

@@ -133,7 +133,6 @@ static void check_structure(const rc__mesh *mesh)
 static void hit_init(rc__hit *h, float t)
 {
     h->t = t;
-    h->u = h->v = 0.0f;
     h->prim = h->geom = h->inst = h->slot = RC_INVALID_ID;
 }
 
@@ -153,8 +152,6 @@ static void compare_ray(const rc__mesh *wide, const rc__mesh *binary, const floa
     if (fw) {
         assert_int_equal(hw.prim, hb.prim);
         assert_memory_equal(&hw.t, &hb.t, sizeof(float));
-        assert_memory_equal(&hw.u, &hb.u, sizeof(float));
-        assert_memory_equal(&hw.v, &hb.v, sizeof(float));
         assert_int_equal(rc__mesh_occluded(wide, &r, hw.t * 1.001f), 1);
     }
     assert_int_equal(rc__mesh_occluded(wide, &r, FAR), rc__mesh_occluded(binary, &r, FAR));
@@ -301,8 +298,6 @@ static void test_rays_in_turns(void **state)
             assert_int_equal(hits[i].prim, h.prim);
             assert_int_equal(hits[i].slot, h.slot);
             assert_memory_equal(&hits[i].t, &h.t, sizeof(float));
-            assert_memory_equal(&hits[i].u, &h.u, sizeof(float));
-            assert_memory_equal(&hits[i].v, &h.v, sizeof(float));
         }
     }
     assert_true(hits_seen > 0);

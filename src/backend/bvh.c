@@ -99,7 +99,6 @@ static void world_ray_ondn(const rc__xformf *world, const float *ds, const float
 static void hit_reset(rc__hit *hit, float tmax)
 {
     hit->t = tmax;
-    hit->u = hit->v = 0.0f;
     hit->prim = hit->geom = hit->inst = hit->slot = RC_INVALID_ID;
 }
 

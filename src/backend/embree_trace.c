@@ -113,8 +113,8 @@ typedef struct hit_batch {
 } hit_batch;
 
 /* Adds ray r's hit from Embree (prefetching its index triple). */
-static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, uint32_t r, float tfar, float u,
-                             float v, uint32_t prim, uint32_t geom, uint32_t inst)
+static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, uint32_t r, float tfar,
+                             uint32_t prim, uint32_t geom, uint32_t inst)
 {
     rc__hit *hit = &b->hit[b->count];
     int found = geom != RTC_INVALID_GEOMETRY_ID;
@@ -124,13 +124,10 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, 
     b->count++;
     if (!found) {
         hit->t = INFINITY;
-        hit->u = hit->v = 0.0f;
         hit->prim = hit->geom = hit->inst = hit->slot = RC_INVALID_ID;
         return;
     }
     hit->t = tfar;
-    hit->u = u;
-    hit->v = v;
     hit->geom = geom;
     hit->prim = prim;
     hit->slot = RC_INVALID_ID; /* Embree's own order */
@@ -218,7 +215,7 @@ static void batch_write(const trace_run *run, const rc__xformf *worlds, uint32_t
         INTERSECT(q, pk.valid, run->scene, &pk.rh);                                                           \
         for (l = 0; l < (W); ++l)                                                                             \
             if (pk.valid[l])                                                                                  \
-                batch_add(run, b, pose, ray[l], pk.rh.ray.tfar[l], pk.rh.hit.u[l], pk.rh.hit.v[l],            \
+                batch_add(run, b, pose, ray[l], pk.rh.ray.tfar[l], \
                           pk.rh.hit.primID[l], pk.rh.hit.geomID[l], pk.rh.hit.instID[0][l]);                  \
     }
 
@@ -257,7 +254,7 @@ static void tile1(const trace_run *run, const rc__xformf *world, uint32_t pose, 
     rh.hit.primID = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
     RC__RTC_INTERSECT1(q, run->scene, &rh);
-    batch_add(run, b, pose, r, rh.ray.tfar, rh.hit.u, rh.hit.v, rh.hit.primID, rh.hit.geomID, rh.hit.instID[0]);
+    batch_add(run, b, pose, r, rh.ray.tfar, rh.hit.primID, rh.hit.geomID, rh.hit.instID[0]);
 }
 
 /* Traces count tiles in order, writing hits a batch behind so that one

@@ -245,25 +245,21 @@ static inline int rc__hit_key_less(uint32_t inst, uint32_t geom, uint32_t prim, 
     return prim < h->prim;
 }
 
-/* Records (t, u, v) on triangle prim as the nearest hit when it beats *h:
- * nearer, or as near with a smaller key. Returns 1 when it did. */
-static inline void rc__hit_record(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot,
-                                  uint32_t geom, uint32_t inst)
+/* Records t on triangle prim as the nearest hit when it beats *h: nearer,
+ * or as near with a smaller key. Returns 1 when it did. */
+static inline void rc__hit_record(rc__hit *h, float t, uint32_t prim, uint32_t slot, uint32_t geom, uint32_t inst)
 {
     h->t = t;
-    h->u = u;
-    h->v = v;
     h->prim = prim;
     h->slot = slot;
     h->geom = geom;
     h->inst = inst;
 }
 
-static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t prim, uint32_t slot, uint32_t geom,
-                                uint32_t inst)
+static inline int rc__hit_offer(rc__hit *h, float t, uint32_t prim, uint32_t slot, uint32_t geom, uint32_t inst)
 {
     if (t > h->t || (t == h->t && !rc__hit_key_less(inst, geom, prim, h))) return 0;
-    rc__hit_record(h, t, u, v, prim, slot, geom, inst);
+    rc__hit_record(h, t, prim, slot, geom, inst);
     return 1;
 }
 
@@ -275,15 +271,15 @@ static inline int rc__hit_offer(rc__hit *h, float t, float u, float v, uint32_t 
  * pending prim until rc__hit_settle. The references are a separate array from
  * the leaf data, and reading one per candidate hit measured as a cache miss
  * on large maps; one read per ray at the end is off the traversal's path. */
-static inline int rc__hit_offer_slot(rc__hit *h, float t, float u, float v, const uint32_t *refs, uint32_t slot,
-                                     uint32_t geom, uint32_t inst)
+static inline int rc__hit_offer_slot(rc__hit *h, float t, const uint32_t *refs, uint32_t slot, uint32_t geom,
+                                     uint32_t inst)
 {
     if (t > h->t) return 0;
     if (t == h->t) {
         if (h->prim == RC__PRIM_PENDING) h->prim = refs[h->slot];
         if (!rc__hit_key_less(inst, geom, refs[slot], h)) return 0;
     }
-    rc__hit_record(h, t, u, v, RC__PRIM_PENDING, slot, geom, inst);
+    rc__hit_record(h, t, RC__PRIM_PENDING, slot, geom, inst);
     return 1;
 }
 

@@ -1,8 +1,8 @@
 /* A leaf's (up to) four triangles against one ray at once: the watertight
  * test (shear, edge functions, sign test, determinant, distance) in SSE2 or
  * NEON lanes. Every lane repeats the scalar test's operations in the same
- * order (IEEE single precision, no contraction), so a lane's edge functions,
- * t and barycentrics are rc__tri_intersect's bit for bit, and a lane that
+ * order (IEEE single precision, no contraction), so a lane's edge functions
+ * and t are rc__tri_intersect's bit for bit, and a lane that
  * test would reject is rejected here. Lanes that reach one of its rare
  * double-precision cases (a zero edge function, a NaN from overflow, an
  * origin in the triangle's plane) go to rc__tri_intersect, which decides.
@@ -131,13 +131,12 @@ static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return rc__neon_bit
 
 /* The watertight test of one ray against a leaf's (up to) four triangles,
  * as far as the SIMD lanes take it (rc__leaf4_test): bit i of hit says
- * triangle i is met at t[i], with barycentrics V[i] / det[i] and W[i] /
- * det[i], unless it has zero area (rc__leaf4_take checks that, for the few
+ * triangle i is met at t[i], unless it has zero area (rc__leaf4_take checks that, for the few
  * triangles a ray is offered); bit i of redo says rc__tri_intersect must
  * decide (a zero edge function, a NaN from overflow, an origin near the
  * triangle's plane: its double-precision cases). Every other triangle misses. */
 typedef struct rc__leaf4_out {
-    float t[4], V[4], W[4], det[4];
+    float t[4];
     uint32_t hit, redo;
 } rc__leaf4_out;
 
@@ -152,8 +151,7 @@ static RC__FORCE_INLINE int rc__leaf4_have_avx2(void) { return __builtin_cpu_sup
 
 #if defined(RC__LEAF4_SSE2) || (defined(RC__LEAF4_NEON) && defined(__aarch64__))
 /* The whole test in lanes, not only its reject half: every lane repeats the
- * scalar test's operations in the same order, so t and the barycentrics are
- * its own bit for bit, and the scalar test is left only its rare cases (it
+ * scalar test's operations in the same order, so t is its own bit for bit, and the scalar test is left only its rare cases (it
  * redid the shear and the edge functions for every candidate: 9% of the
  * time of a 1k map). 32-bit ARM keeps the filter: its NEON flushes
  * subnormals to zero and has no division. */
@@ -194,15 +192,14 @@ static RC__FORCE_INLINE void rc__leaf4_run(const rc__ray *r, rc__v4 ax, rc__v4 a
                                           rc__v4 bz, rc__v4 cx, rc__v4 cy, rc__v4 cz, uint32_t count,
                                           rc__leaf4_out *o)
 {
-    rc__v4 t, V, W, det;
+    rc__v4 t;
     rc__leaf4_lanes(ax, ay, az, bx, by, bz, cx, cy, cz, RC__V4_SET1(r->org[r->kx]), RC__V4_SET1(r->org[r->ky]),
                     RC__V4_SET1(r->org[r->kz]), RC__V4_SET1(r->sx), RC__V4_SET1(r->sy), RC__V4_SET1(r->sz),
-                    (1u << count) - 1u, &o->hit, &o->redo, &t, &V, &W, &det);
+                    (1u << count) - 1u, &o->hit, &o->redo, &t);
 #if defined(RC__LEAF4_FULL)
     RC__V4_STORE(o->t, t);
-    RC__V4_STORE(o->V, V);
-    RC__V4_STORE(o->W, W);
-    RC__V4_STORE(o->det, det);
+#else
+    (void)t;
 #endif
 }
 #endif
@@ -258,8 +255,8 @@ static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf
 #endif
 }
 
-/* Triangle c of a leaf tested by rc__leaf4_test: 1 with *t, *u, *v as
- * rc__tri_intersect gives them when it is hit, else 0. tv: its vertices.
+/* Triangle c of a leaf tested by rc__leaf4_test: 1 with *t as
+ * rc__tri_intersect gives it when it is hit, else 0. tv: its vertices.
  * The zero-area check depends on the triangle alone: *known and *flat keep
  * its answers per slot (bit c), so a leaf that a packet's lanes test in
  * turn runs it once per triangle (1k sphere: 4% of the time, once a lane).
@@ -267,29 +264,27 @@ static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf
  * zero-area triangle is (a, a, a), which the lanes never report as a hit
  * (zero edge functions: a redo, which ends at the vertex compare below). */
 static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, const rc__ray *r,
-                                          const float *const tv[3], uint32_t *known, uint32_t *flat, float *t,
-                                          float *u, float *v)
+                                          const float *const tv[3], uint32_t *known, uint32_t *flat, float *t)
 {
+    float u, v; /* the scalar test's barycentrics: no result needs them */
     /* two vertices the same (a folded zero-area triangle, (a, a, a), lands
      * here every time: its edge functions are all exactly 0): never a hit */
     if (tv[0] == tv[1]) return 0;
 #if defined(RC__LEAF4_FULL)
-    if ((o->redo >> c) & 1u) return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, u, v);
+    if ((o->redo >> c) & 1u) return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
     if (!((*known >> c) & 1u)) {
         *known |= 1u << c;
         *flat |= (uint32_t)rc__tri_zero_area(tv[0], tv[1], tv[2]) << c;
     }
     if ((*flat >> c) & 1u) return 0;
     *t = o->t[c];
-    *u = o->V[c] / o->det[c];
-    *v = o->W[c] / o->det[c];
     return 1;
 #else
     (void)o;
     (void)c;
     (void)known;
     (void)flat;
-    return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, u, v);
+    return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
 #endif
 }
 

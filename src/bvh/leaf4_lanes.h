@@ -18,18 +18,17 @@
  * DIV, EQ, ABS and UNORDERED are then not needed.
  *
  * Every lane repeats rc__tri_intersect's operations in its order, so its
- * edge functions, t and barycentrics are the scalar test's bit for bit. The
+ * edge functions and t are the scalar test's bit for bit. The
  * inputs are the three vertices' coordinates along the ray's kx, ky, kz, and
  * the ray's origin along them and shear constants, per lane; `all` has a bit
  * for each lane that holds a real triangle. The outputs are rc__leaf4_out's
- * (leaf4.h): *hit and *redo as bits, and t, V, W and det per lane (zero in
- * every lane when no lane survives the sign test; unset with
- * RC__VL_FILTER_ONLY). */
+ * (leaf4.h): *hit and *redo as bits, and t per lane (zero in every lane
+ * when no lane survives the sign test; unset with RC__VL_FILTER_ONLY). No
+ * result needs the barycentrics, so they are not computed. */
 static RC__FORCE_INLINE RC__VL_ATTR void RC__VL_NAME(RC__VL_T ax, RC__VL_T ay, RC__VL_T az_, RC__VL_T bx, RC__VL_T by,
                                                      RC__VL_T bz_, RC__VL_T cx, RC__VL_T cy, RC__VL_T cz_, RC__VL_T ox,
                                                      RC__VL_T oy, RC__VL_T oz, RC__VL_T sx, RC__VL_T sy, RC__VL_T sz,
-                                                     uint32_t all, uint32_t *hit, uint32_t *redo, RC__VL_T *t,
-                                                     RC__VL_T *V_out, RC__VL_T *W_out, RC__VL_T *det_out)
+                                                     uint32_t all, uint32_t *hit, uint32_t *redo, RC__VL_T *t)
 {
     const RC__VL_T zero = RC__VL_SET1(0.0f);
     const RC__VL_T az = RC__VL_SUB(az_, oz), bz = RC__VL_SUB(bz_, oz), cz = RC__VL_SUB(cz_, oz);
@@ -71,14 +70,11 @@ static RC__FORCE_INLINE RC__VL_ATTR void RC__VL_NAME(RC__VL_T ax, RC__VL_T ay, R
         *redo = all & RC__VL_BITS(RC__VL_OR(redo_m, tiny));
         *hit = all & RC__VL_BITS(RC__VL_ANDNOT(tiny, pass));
         *t = tt;
-        *V_out = V;
-        *W_out = W;
-        *det_out = det;
     } else {
         *redo = all & RC__VL_BITS(redo_m);
         *hit = 0;
         /* never read (no hit bit); set so no path reads them unset */
-        *t = *V_out = *W_out = *det_out = zero;
+        *t = zero;
     }
 #else
     /* A flushed value reads as zero where the scalar test (VFP) keeps it, so
@@ -102,9 +98,6 @@ static RC__FORCE_INLINE RC__VL_ATTR void RC__VL_NAME(RC__VL_T ax, RC__VL_T ay, R
 #undef RC__VL_TINY3
         (void)sz;
         (void)t;
-        (void)V_out;
-        (void)W_out;
-        (void)det_out;
         *redo = all & ~RC__VL_BITS(RC__VL_ANDNOT(RC__VL_OR(inputs, RC__VL_OR(shear, edges)), rejected));
         *hit = 0;
     }

@@ -47,7 +47,7 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_
     rc__leaf4_out *ob)
 {
     const uint32_t all4 = (1u << count) - 1u;
-    __m256 t, V, W, det;
+    __m256 t;
     uint32_t hit, redo;
     leaf8_lanes(PAIR_ROW(s->c[0][ra->kx], s->c[0][rb->kx]), PAIR_ROW(s->c[0][ra->ky], s->c[0][rb->ky]),
                 PAIR_ROW(s->c[0][ra->kz], s->c[0][rb->kz]), PAIR_ROW(s->c[1][ra->kx], s->c[1][rb->kx]),
@@ -56,19 +56,13 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_
                 PAIR_ROW(s->c[2][ra->kz], s->c[2][rb->kz]), PAIR_SET(ra->org[ra->kx], rb->org[rb->kx]),
                 PAIR_SET(ra->org[ra->ky], rb->org[rb->ky]), PAIR_SET(ra->org[ra->kz], rb->org[rb->kz]),
                 PAIR_SET(ra->sx, rb->sx), PAIR_SET(ra->sy, rb->sy), PAIR_SET(ra->sz, rb->sz), all4 | all4 << 4, &hit,
-                &redo, &t, &V, &W, &det);
+                &redo, &t);
     oa->hit = hit & 15u;
     ob->hit = hit >> 4;
     oa->redo = redo & 15u;
     ob->redo = redo >> 4;
     _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
     _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
-    _mm_storeu_ps(oa->V, _mm256_castps256_ps128(V));
-    _mm_storeu_ps(ob->V, _mm256_extractf128_ps(V, 1));
-    _mm_storeu_ps(oa->W, _mm256_castps256_ps128(W));
-    _mm_storeu_ps(ob->W, _mm256_extractf128_ps(W, 1));
-    _mm_storeu_ps(oa->det, _mm256_castps256_ps128(det));
-    _mm_storeu_ps(ob->det, _mm256_extractf128_ps(det, 1));
 }
 #undef PAIR_ROW
 #undef PAIR_SET

@@ -195,7 +195,7 @@ static RC__FORCE_INLINE int rc__traverse(const rc__mesh *mesh, const rc__ray *ra
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (!rc__hit_offer(hit, t, u, v, prim, j, geom, inst)) continue;
+                if (!rc__hit_offer(hit, t, prim, j, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }

@@ -45,8 +45,8 @@ typedef struct rc__ray {
 
 /* Nearest hit found so far. t = tmax before the search. */
 typedef struct rc__hit {
-    float t;
-    float u, v;        /* barycentrics of the hit on triangle prim */
+    float t;           /* no barycentrics: no result needs them (rc__tri_intersect
+                        * computes them for whoever does) */
     uint32_t prim;     /* triangle index within its mesh */
     uint32_t geom;     /* geometry id within its scene */
     uint32_t inst;     /* instance id or RC_INVALID_ID */
@@ -75,7 +75,7 @@ void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);
 /* Searches the mesh for a hit with 0 < t < hit->t (or t == hit->t and a smaller
  * (inst, geom, prim) key: the tie rule that makes coplanar overlaps pick the
  * same triangle on every backend and thread count). Zero-area triangles never
- * hit. On a closer hit, updates *hit (t, u, v, prim, and geom/inst from the
+ * hit. On a closer hit, updates *hit (t, prim, and geom/inst from the
  * arguments) and returns 1; else 0. */
 int rc__mesh_intersect(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                        rc__hit *hit);

@@ -522,10 +522,10 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
     uint32_t cand = lo->hit | lo->redo;
     while (cand) {
         const uint32_t c = lowest_lane(cand); /* a triangle slot here, not a lane */
-        float t, u, v;
+        float t;
         cand &= cand - 1u;
-        if (!rc__leaf4_take(lo, c, &T->rays[lane], vt[c], known, flat, &t, &u, &v)) continue;
-        if (!rc__hit_offer_slot(&T->hits[lane], t, u, v, mesh->bvh.refs, child + c, geom, inst)) continue;
+        if (!rc__leaf4_take(lo, c, &T->rays[lane], vt[c], known, flat, &t)) continue;
+        if (!rc__hit_offer_slot(&T->hits[lane], t, mesh->bvh.refs, child + c, geom, inst)) continue;
         lane_set_tmax(&T->L, lane, t);
         T->found[lane] = 1;
         *shrunk = 1;

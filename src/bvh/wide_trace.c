@@ -140,14 +140,14 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
             while (cand) {
                 const uint32_t j = child + lowest_bit(cand);
                 const float *const *tv = vt[j - child];
-                float t, u, v;
+                float t;
                 cand &= cand - 1u;
-                if (!rc__leaf4_take(&lo, j - child, &r, tv, &known, &flat, &t, &u, &v)) continue;
+                if (!rc__leaf4_take(&lo, j - child, &r, tv, &known, &flat, &t)) continue;
                 if (any_hit) {
                     if (t < tmax) return 1;
                     continue;
                 }
-                if (t > tcur || !rc__hit_offer_slot(hit, t, u, v, refs, j, geom, inst)) continue;
+                if (t > tcur || !rc__hit_offer_slot(hit, t, refs, j, geom, inst)) continue;
                 tcur = t;
                 found = 1;
             }
@@ -249,10 +249,10 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
         while (cand) {
             const uint32_t j = T->child + lowest_bit(cand);
             const float *const *tv = vt[j - T->child];
-            float t, u, v;
+            float t;
             cand &= cand - 1u;
-            if (!rc__leaf4_take(&lo, j - T->child, &T->r, tv, &known, &flat, &t, &u, &v)) continue;
-            if (t > T->tcur || !rc__hit_offer_slot(T->hit, t, u, v, mesh->bvh.refs, j, geom, inst)) continue;
+            if (!rc__leaf4_take(&lo, j - T->child, &T->r, tv, &known, &flat, &t)) continue;
+            if (t > T->tcur || !rc__hit_offer_slot(T->hit, t, mesh->bvh.refs, j, geom, inst)) continue;
             T->tcur = t;
             T->found = 1;
         }

@@ -84,7 +84,7 @@ static void offer_all(rc__hit *h, const float *verts, const mesh_split *ms, cons
             float t, u, v;
             const float *a = verts + 9u * i;
             const uint32_t prim = i - ms->first[m];
-            if (rc__tri_intersect(ray, a, a + 3, a + 6, &t, &u, &v)) rc__hit_offer(h, t, u, v, prim, prim, m, inst);
+            if (rc__tri_intersect(ray, a, a + 3, a + 6, &t, &u, &v)) rc__hit_offer(h, t, prim, prim, m, inst);
         }
 }
 
@@ -118,7 +118,6 @@ static rc__hit brute_nearest(const rc_scene *scene, int own_meshes, const float 
     rc__hit h;
     uint32_t k;
     h.t = RANGE_MAX;
-    h.u = h.v = 0.0f;
     h.prim = h.geom = h.inst = h.slot = RC_INVALID_ID;
     if (own_meshes) {
         ray_in_frame(scene, RC_INVALID_ID, org, dir, &ray);
