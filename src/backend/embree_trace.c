@@ -215,7 +215,7 @@ static void batch_write(const trace_run *run, const rc__xformf *worlds, uint32_t
         INTERSECT(q, pk.valid, run->scene, &pk.rh);                                                           \
         for (l = 0; l < (W); ++l)                                                                             \
             if (pk.valid[l])                                                                                  \
-                batch_add(run, b, pose, ray[l], pk.rh.ray.tfar[l], \
+                batch_add(run, b, pose, ray[l], pk.rh.ray.tfar[l],                                            \
                           pk.rh.hit.primID[l], pk.rh.hit.geomID[l], pk.rh.hit.instID[0][l]);                  \
     }
 

@@ -131,10 +131,11 @@ static RC__FORCE_INLINE uint32_t rc__v4_bits(rc__v4mask m) { return rc__neon_bit
 
 /* The watertight test of one ray against a leaf's (up to) four triangles,
  * as far as the SIMD lanes take it (rc__leaf4_test): bit i of hit says
- * triangle i is met at t[i], unless it has zero area (rc__leaf4_take checks that, for the few
- * triangles a ray is offered); bit i of redo says rc__tri_intersect must
- * decide (a zero edge function, a NaN from overflow, an origin near the
- * triangle's plane: its double-precision cases). Every other triangle misses. */
+ * triangle i is met at t[i], unless it has zero area (rc__leaf4_take
+ * checks that, for the few triangles a ray is offered); bit i of redo says
+ * rc__tri_intersect must decide (a zero edge function, a NaN from overflow,
+ * an origin near the triangle's plane: its double-precision cases). Every
+ * other triangle misses. */
 typedef struct rc__leaf4_out {
     float t[4];
     uint32_t hit, redo;
@@ -151,10 +152,11 @@ static RC__FORCE_INLINE int rc__leaf4_have_avx2(void) { return __builtin_cpu_sup
 
 #if defined(RC__LEAF4_SSE2) || (defined(RC__LEAF4_NEON) && defined(__aarch64__))
 /* The whole test in lanes, not only its reject half: every lane repeats the
- * scalar test's operations in the same order, so t is its own bit for bit, and the scalar test is left only its rare cases (it
- * redid the shear and the edge functions for every candidate: 9% of the
- * time of a 1k map). 32-bit ARM keeps the filter: its NEON flushes
- * subnormals to zero and has no division. */
+ * scalar test's operations in the same order, so t is its own bit for bit,
+ * and the scalar test is left only its rare cases (it redid the shear and
+ * the edge functions for every candidate: 9% of the time of a 1k map).
+ * 32-bit ARM keeps the filter: its NEON flushes subnormals to zero and has
+ * no division. */
 #define RC__LEAF4_FULL 1
 #endif
 
