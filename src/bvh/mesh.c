@@ -74,10 +74,19 @@ void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out)
         memcpy(out + (size_t)3 * j, mesh->indices + (size_t)3 * mesh->bvh.refs[j], 3 * sizeof(uint32_t));
 }
 
-uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
+void rc__mesh_unfold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
 {
     uint32_t j;
     for (j = 0; j < mesh->triangle_count; ++j) {
+        uint32_t *t = leaf_tris + (size_t)3 * j;
+        if (t[0] == t[1] && t[1] == t[2]) memcpy(t, mesh->indices + (size_t)3 * mesh->bvh.refs[j], 3 * sizeof(uint32_t));
+    }
+}
+
+uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris, uint32_t first, uint32_t end)
+{
+    uint32_t j;
+    for (j = first; j < end; ++j) {
         uint32_t *t = leaf_tris + (size_t)3 * j;
         if (rc__tri_zero_area(rc__vertex(mesh, t[0]), rc__vertex(mesh, t[1]), rc__vertex(mesh, t[2])))
             t[1] = t[2] = t[0];
