@@ -76,7 +76,9 @@ void rc__scene_bake(const rc_scene *scene, unsigned char *blob)
         memcpy(blob + s.indices, m->indices, (size_t)m->triangle_count * 3u * sizeof(uint32_t));
         memcpy(blob + s.refs, m->bvh.refs, (size_t)m->triangle_count * sizeof(uint32_t));
         /* the triples as the format has them, whole (the mesh's own copy
-         * has its zero-area triangles folded: rc__mesh_fold_flats) */
+         * has its zero-area triangles folded: rc__mesh_fold_flats); what
+         * rc__mesh_fill_leaf_tris writes, byte-wise here because a bake's
+         * buffer need not be aligned */
         for (i = 0; i < m->triangle_count; ++i)
             memcpy(blob + s.leaf_tris + (size_t)i * 12u, m->indices + (size_t)3 * m->bvh.refs[i], 12);
         memcpy(blob + s.nodes, m->wide, (size_t)m->wide_count * sizeof(rc__wnode));
