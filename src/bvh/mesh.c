@@ -83,10 +83,10 @@ void rc__mesh_unfold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
     }
 }
 
-uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris, uint32_t first, uint32_t end)
+uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
 {
     uint32_t j;
-    for (j = first; j < end; ++j) {
+    for (j = 0; j < mesh->triangle_count; ++j) {
         uint32_t *t = leaf_tris + (size_t)3 * j;
         if (rc__tri_zero_area(rc__vertex(mesh, t[0]), rc__vertex(mesh, t[1]), rc__vertex(mesh, t[2])))
             t[1] = t[2] = t[0];

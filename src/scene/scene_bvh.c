@@ -95,34 +95,6 @@ void rc__scene_release_bvh(rc_scene *scene)
     }
 }
 
-/* Folding a large mesh's zero-area triangles (rc__mesh_fold_flats: an area
- * test in double for every triangle) runs on the pool, FOLD_SLOTS slots a
- * task (a refit of the 1M-triangle sphere, 2 threads: 8 ms before the fold,
- * 14-16 ms with it on one thread and the triples filled again, 8-13 ms now). */
-#define FOLD_SLOTS 65536u
-
-typedef struct fold_job {
-    const rc__mesh *mesh;
-    uint32_t *leaf_tris;
-} fold_job;
-
-static void fold_task(void *user, uint32_t task, uint32_t thread)
-{
-    const fold_job *f = (const fold_job *)user;
-    const uint32_t first = task * FOLD_SLOTS, left = f->mesh->triangle_count - first;
-    (void)thread;
-    rc__mesh_fold_flats(f->mesh, f->leaf_tris, first, first + (left < FOLD_SLOTS ? left : FOLD_SLOTS));
-}
-
-static uint32_t fold_flats(rc__pool *pool, const rc__mesh *mesh, uint32_t *leaf_tris)
-{
-    fold_job f;
-    f.mesh = mesh;
-    f.leaf_tris = leaf_tris;
-    rc__pool_run(pool, (mesh->triangle_count + FOLD_SLOTS - 1u) / FOLD_SLOTS, fold_task, &f);
-    return 1u;
-}
-
 static void aabb_empty(rc__aabb *b)
 {
     b->min[0] = b->min[1] = b->min[2] = 3.0e38f;
@@ -248,7 +220,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             rc__bvh_build_mt(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
                              ctx->pool, progress, user);
             rc__mesh_fill_leaf_tris(mesh, lt);
-            mesh->flats_folded = fold_flats(ctx->pool, mesh, lt);
+            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
             mesh->leaf_tris = lt;
             if (wide) {
                 mesh->wide = wnodes + wide_off;
@@ -267,7 +239,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
                 rc__mesh_triangle_bounds(mesh, item_bounds);
                 rc__bvh_refit(&mesh->bvh, item_bounds);
             }
-            mesh->flats_folded = fold_flats(ctx->pool, mesh, lt);
+            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
         }
         geo->dirty = 0;
         node_off += n + (n & 1u); /* the next mesh starts at an even index */
