@@ -264,16 +264,16 @@ static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf
  * turn runs it once per triangle (1k sphere: 4% of the time, once a lane).
  * Callers start *known at 0xF for a mesh whose flats_folded is set: there a
  * zero-area triangle is (a, a, a), which the lanes never report as a hit
- * (zero edge functions: a redo, which ends at the vertex compare below). */
+ * (zero edge functions: a redo, which the vertex compare below ends). */
 static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, const rc__ray *r,
                                           const float *const tv[3], uint32_t *known, uint32_t *flat, float *t)
 {
     float u, v; /* the scalar test's barycentrics: no result needs them */
-    /* two vertices the same (a folded zero-area triangle, (a, a, a), lands
-     * here every time: its edge functions are all exactly 0): never a hit */
-    if (tv[0] == tv[1]) return 0;
+    /* only the scalar test's cases can hold two vertices the same (a folded
+     * zero-area triangle, (a, a, a), comes every time: its edge functions
+     * are all exactly 0); such a triangle is never hit */
 #if defined(RC__LEAF4_FULL)
-    if ((o->redo >> c) & 1u) return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
+    if ((o->redo >> c) & 1u) return tv[0] != tv[1] && rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
     if (!((*known >> c) & 1u)) {
         *known |= 1u << c;
         *flat |= (uint32_t)rc__tri_zero_area(tv[0], tv[1], tv[2]) << c;
@@ -286,7 +286,7 @@ static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, c
     (void)c;
     (void)known;
     (void)flat;
-    return rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
+    return tv[0] != tv[1] && rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
 #endif
 }
 

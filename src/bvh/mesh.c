@@ -83,7 +83,7 @@ void rc__mesh_unfold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
     }
 }
 
-uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
+void rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
 {
     uint32_t j;
     for (j = 0; j < mesh->triangle_count; ++j) {
@@ -91,7 +91,6 @@ uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris)
         if (rc__tri_zero_area(rc__vertex(mesh, t[0]), rc__vertex(mesh, t[1]), rc__vertex(mesh, t[2])))
             t[1] = t[2] = t[0];
     }
-    return 1u;
 }
 
 void rc__mesh_triangle_normal(const rc__mesh *mesh, uint32_t prim, float n[3])

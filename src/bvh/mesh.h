@@ -68,9 +68,9 @@ void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out);
  * (a sequential pass: few triples are folded). */
 void rc__mesh_unfold_flats(const rc__mesh *mesh, uint32_t *leaf_tris);
 /* Rewrites every zero-area triangle (rc__tri_zero_area) of those triples as
- * (a, a, a), in place; returns 1, the value for flats_folded once they are
- * the mesh's leaf_tris. Boxes are computed from the triples before this. */
-uint32_t rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris);
+ * (a, a, a), in place (then set flats_folded once they are the mesh's
+ * leaf_tris). Boxes are computed from the triples before this. */
+void rc__mesh_fold_flats(const rc__mesh *mesh, uint32_t *leaf_tris);
 
 /* Item bounds of every triangle (for the builder). */
 void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out);

@@ -220,7 +220,8 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             rc__bvh_build_mt(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
                              ctx->pool, progress, user);
             rc__mesh_fill_leaf_tris(mesh, lt);
-            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
+            rc__mesh_fold_flats(mesh, lt);
+            mesh->flats_folded = 1;
             mesh->leaf_tris = lt;
             if (wide) {
                 mesh->wide = wnodes + wide_off;
@@ -239,7 +240,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
                 rc__mesh_triangle_bounds(mesh, item_bounds);
                 rc__bvh_refit(&mesh->bvh, item_bounds);
             }
-            mesh->flats_folded = rc__mesh_fold_flats(mesh, lt);
+            rc__mesh_fold_flats(mesh, lt); /* flats_folded stays 1, from the build */
         }
         geo->dirty = 0;
         node_off += n + (n & 1u); /* the next mesh starts at an even index */
