@@ -177,12 +177,11 @@ RC__COLD int rc__tri_plane_t_double(const rc__ray *r, const float *a, const floa
     return *t > 0.0f;
 }
 
-/* Watertight test of triangle (a, b, c), either winding. On a hit with t > 0
- * returns 1 with *t (in units of |dir|), the barycentrics *u (weight of b) and
- * *v (weight of c): the point is (1 - u - v) a + u b + v c, as in Embree. The
- * caller compares t with its current nearest. */
-static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, const float *b,
-                                              const float *c, float *t, float *u, float *v)
+/* rc__tri_intersect less its last step, the zero-area check: for callers
+ * that know the answer already (leaf4.h: rc__leaf4_take). A triangle of zero
+ * area that this passes has a hit only by rounding. */
+static RC__FORCE_INLINE int rc__tri_intersect_any_area(const rc__ray *r, const float *a, const float *b,
+                                                       const float *c, float *t, float *u, float *v)
 {
     const int kx = r->kx, ky = r->ky, kz = r->kz;
     const float ox = r->org[kx], oy = r->org[ky], oz = r->org[kz];
@@ -230,11 +229,21 @@ static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, 
                                                            (cz < 0.0f ? -cz : cz))) {
         if (!rc__tri_plane_t_double(r, a, b, c, &tt)) return 0;
     }
-    if (rc__tri_zero_area(a, b, c)) return 0;
     *t = tt;
     *u = V / det;
     *v = W / det;
     return 1;
+}
+
+/* Watertight test of triangle (a, b, c), either winding. On a hit with t > 0
+ * returns 1 with *t (in units of |dir|), the barycentrics *u (weight of b) and
+ * *v (weight of c): the point is (1 - u - v) a + u b + v c, as in Embree. The
+ * caller compares t with its current nearest. A triangle of zero area is
+ * never hit (on 0, *t, *u and *v may have been written). */
+static RC__FORCE_INLINE int rc__tri_intersect(const rc__ray *r, const float *a, const float *b,
+                                              const float *c, float *t, float *u, float *v)
+{
+    return rc__tri_intersect_any_area(r, a, b, c, t, u, v) && !rc__tri_zero_area(a, b, c);
 }
 
 /* Tie rule of rc__mesh_intersect: (inst, geom, prim) lexicographically smaller. */

@@ -263,31 +263,30 @@ static RC__FORCE_INLINE void rc__leaf4_test_soa(const rc__ray *r, const rc__leaf
  * its answers per slot (bit c), so a leaf that a packet's lanes test in
  * turn runs it once per triangle (1k sphere: 4% of the time, once a lane).
  * Callers start *known at 0xF for a mesh whose flats_folded is set: there a
- * zero-area triangle is (a, a, a), which the lanes never report as a hit
- * (zero edge functions: a redo, which the vertex compare below ends). */
+ * zero-area triangle is (a, a, a), which is never hit (the lanes find its
+ * edge functions all exactly 0 and hand it to the scalar test, and the
+ * vertex compare below ends it), so no hit needs the check. */
 static RC__FORCE_INLINE int rc__leaf4_take(const rc__leaf4_out *o, uint32_t c, const rc__ray *r,
                                           const float *const tv[3], uint32_t *known, uint32_t *flat, float *t)
 {
     float u, v; /* the scalar test's barycentrics: no result needs them */
-    /* only the scalar test's cases can hold two vertices the same (a folded
-     * zero-area triangle, (a, a, a), comes every time: its edge functions
-     * are all exactly 0); such a triangle is never hit */
 #if defined(RC__LEAF4_FULL)
-    if ((o->redo >> c) & 1u) return tv[0] != tv[1] && rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
+    const uint32_t scalar = (o->redo >> c) & 1u; /* else a hit the lanes settled */
+#else
+    const uint32_t scalar = 1u; /* the lanes only filter */
+    (void)o;
+#endif
+    /* only the scalar test's cases can hold two vertices the same (a folded
+     * zero-area triangle) */
+    if (!scalar)
+        *t = o->t[c];
+    else if (!(tv[0] != tv[1] && rc__tri_intersect_any_area(r, tv[0], tv[1], tv[2], t, &u, &v)))
+        return 0;
     if (!((*known >> c) & 1u)) {
         *known |= 1u << c;
         *flat |= (uint32_t)rc__tri_zero_area(tv[0], tv[1], tv[2]) << c;
     }
-    if ((*flat >> c) & 1u) return 0;
-    *t = o->t[c];
-    return 1;
-#else
-    (void)o;
-    (void)c;
-    (void)known;
-    (void)flat;
-    return tv[0] != tv[1] && rc__tri_intersect(r, tv[0], tv[1], tv[2], t, &u, &v);
-#endif
+    return !((*flat >> c) & 1u);
 }
 
 #endif
