@@ -3,9 +3,10 @@
  * barycentrics, bit for bit, for coherent tiles, mixed-octant tiles, axis-
  * parallel rays, planar tiles (a direction component 0 in every lane) and
  * partial packets; so do packets taking turns
- * (rc__mesh_intersect_packets), whatever their number and mix. On x86-64
- * both builds of the traversal (baseline SSE2 and AVX2, packet.c) are run,
- * not only the one the CPU selects. */
+ * (rc__mesh_intersect_packets), whatever their number and mix, and packets
+ * whose rays leave from origins of their own (OnDn beams: millimetres to a
+ * metre apart). On x86-64 both builds of the traversal (baseline SSE2 and
+ * AVX2, packet.c) are run, not only the one the CPU selects. */
 #include <math.h>
 #include <string.h>
 
@@ -74,11 +75,15 @@ static void map_close(test_map *t)
 
 /* Tile number `tile` of the test: nearby directions around a random centre;
  * some straddle axis planes, some are widely spread, some partial, some have
- * exact zero components or start on a box plane. Returns the ray count. */
+ * exact zero components or start on a box plane. With own_origins each ray
+ * leaves from its own point near the tile's (2 mm, 3 cm or 0.8 m away at
+ * most; rays 0, 2, 4 ... keep the tile's coordinate on a box plane).
+ * Returns the ray count. */
 static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit hits[RC__PACKET_SIZE],
-                          int found[RC__PACKET_SIZE])
+                          int found[RC__PACKET_SIZE], int own_origins)
 {
-    float org[3], dir[3];
+    static const double jitter[3] = {0.002, 0.03, 0.8};
+    float org[3], dir[3], ray_org[3];
     double yaw = uniform() * 6.283185307, pitch = (uniform() - 0.5) * 3.0;
     double spread = (tile % 5 == 0) ? 0.5 : 0.02;
     uint32_t n = (tile % 7 == 0) ? 1u + (uint32_t)(uniform() * RC__PACKET_SIZE) % RC__PACKET_SIZE : RC__PACKET_SIZE;
@@ -104,7 +109,13 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
         /* and with a few lanes near but not at 0 (finite and infinite
          * reciprocals in one packet) */
         if (tile % 23 == 0) dir[(tile / 23) % 3] = i % 3 ? -0.0f : -1e-6f * (float)(i + 1);
-        rc__ray_prepare(&rays[i], org, dir);
+        memcpy(ray_org, org, sizeof org);
+        if (own_origins) {
+            uint32_t k;
+            for (k = 0; k < 3; ++k)
+                if (i % 2 || tile % 11 != 0 || k != 0) ray_org[k] += (float)((uniform() - 0.5) * 2.0 * jitter[tile % 3]);
+        }
+        rc__ray_prepare(&rays[i], ray_org, dir);
         hit_init(&hits[i]);
         found[i] = 0;
     }
@@ -112,9 +123,9 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
 }
 
 typedef void (*packet_fn)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                          rc__hit *hits, int *found);
+                          rc__hit *hits, int *found, int own_origins);
 typedef void (*packets_fn)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays, const uint32_t *n,
-                           uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found);
+                           uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found, int own_origins);
 
 /* A build of the traversal: the entry points, or one of the two x86-64
  * builds behind them. */
@@ -131,18 +142,18 @@ static const packet_build baseline = {"baseline SSE2", rc__mesh_intersect_packet
 static const packet_build avx2 = {"AVX2", rc__mesh_intersect_packet_avx2, rc__mesh_intersect_packets_avx2};
 #endif
 
-static void packet_equals_single(const packet_build *b)
+static void packet_equals_single(const packet_build *b, int own_origins)
 {
     test_map t;
     uint32_t tile, tiles = rct_quick() ? 300u : 3000u;
-    print_message("packets: %s build\n", b->name);
+    print_message("packets: %s build%s\n", b->name, own_origins ? ", own origins" : "");
     map_open(&t);
     for (tile = 0; tile < tiles; ++tile) {
         rc__ray rays[RC__PACKET_SIZE];
         rc__hit hits[RC__PACKET_SIZE];
         int found[RC__PACKET_SIZE];
-        const uint32_t n = make_tile(tile, rays, hits, found);
-        b->one(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found);
+        const uint32_t n = make_tile(tile, rays, hits, found, own_origins);
+        b->one(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found, own_origins);
         expect_single(t.mesh, rays, n, hits, found);
     }
     map_close(&t);
@@ -150,14 +161,14 @@ static void packet_equals_single(const packet_build *b)
 
 /* Groups of 1..RC__PACKETS_IN_FLIGHT packets taking turns (each group mixes
  * the tile kinds above, so some members fall back to the plain path). */
-static void packets_in_turns_equal_single(const packet_build *b)
+static void packets_in_turns_equal_single(const packet_build *b, int own_origins)
 {
     test_map t;
     static rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     uint32_t group, tile = 0, groups = rct_quick() ? 60u : 600u;
-    print_message("packets in turns: %s build\n", b->name);
+    print_message("packets in turns: %s build%s\n", b->name, own_origins ? ", own origins" : "");
     map_open(&t);
     for (group = 0; group < groups; ++group) {
         const uint32_t k = 1u + group % RC__PACKETS_IN_FLIGHT;
@@ -166,12 +177,12 @@ static void packets_in_turns_equal_single(const packet_build *b)
         int *pf[RC__PACKETS_IN_FLIGHT];
         uint32_t n[RC__PACKETS_IN_FLIGHT], j;
         for (j = 0; j < k; ++j, ++tile) {
-            n[j] = make_tile(tile, rays[j], hits[j], found[j]);
+            n[j] = make_tile(tile, rays[j], hits[j], found[j], own_origins);
             pr[j] = rays[j];
             ph[j] = hits[j];
             pf[j] = found[j];
         }
-        b->many(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf);
+        b->many(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf, own_origins);
         for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j]);
     }
     map_close(&t);
@@ -180,13 +191,21 @@ static void packets_in_turns_equal_single(const packet_build *b)
 static void test_packet_equals_single(void **state)
 {
     (void)state;
-    packet_equals_single(&selected);
+    packet_equals_single(&selected, 0);
 }
 
 static void test_packets_in_turns_equal_single(void **state)
 {
     (void)state;
-    packets_in_turns_equal_single(&selected);
+    packets_in_turns_equal_single(&selected, 0);
+}
+
+/* OnDn packets: each ray from its own origin */
+static void test_own_origins_equal_single(void **state)
+{
+    (void)state;
+    packet_equals_single(&selected, 1);
+    packets_in_turns_equal_single(&selected, 1);
 }
 
 /* Both x86-64 builds, whichever the CPU selects (the AVX2 one where it has
@@ -195,14 +214,19 @@ static void test_both_builds_equal_single(void **state)
 {
     (void)state;
 #if defined(RC__PACKET_TWO_BUILDS)
-    packet_equals_single(&baseline);
-    packets_in_turns_equal_single(&baseline);
+    int own;
+    for (own = 0; own < 2; ++own) {
+        packet_equals_single(&baseline, own);
+        packets_in_turns_equal_single(&baseline, own);
+    }
     if (!rc__leaf4_have_avx2()) {
         print_message("no AVX2 on this CPU: its build is not run\n");
         return;
     }
-    packet_equals_single(&avx2);
-    packets_in_turns_equal_single(&avx2);
+    for (own = 0; own < 2; ++own) {
+        packet_equals_single(&avx2, own);
+        packets_in_turns_equal_single(&avx2, own);
+    }
 #else
     print_message("one build of the traversal on this target\n");
     skip();
@@ -235,6 +259,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single),
                                        cmocka_unit_test(test_packets_in_turns_equal_single),
+                                       cmocka_unit_test(test_own_origins_equal_single),
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);

@@ -28,7 +28,7 @@
 int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst, rc__hit *hit);
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                               rc__hit *hits, int *found);
+                               rc__hit *hits, int *found, int own_origins);
 
 /* the tools' generator, seeded in main */
 static rcu_rng rng;
@@ -67,8 +67,10 @@ static void test_scalar_equals_simd(void **state)
     for (tile = 0; tile < tiles; ++tile) {
         float org[3];
         rc__ray r[RC__PACKET_SIZE];
-        rc__hit hs[RC__PACKET_SIZE], hv[RC__PACKET_SIZE];
-        int fs[RC__PACKET_SIZE], fv[RC__PACKET_SIZE];
+        rc__hit hs[RC__PACKET_SIZE], hv[RC__PACKET_SIZE], h1[RC__PACKET_SIZE];
+        int fs[RC__PACKET_SIZE], fv[RC__PACKET_SIZE], f1[RC__PACKET_SIZE];
+        /* every third tile an OnDn packet: each ray from its own origin */
+        const int own = tile % 3 == 1;
         double yaw = uniform() * 6.283185307, pitch = (uniform() - 0.5) * 3.0;
         double spread = (tile % 5 == 0) ? 0.5 : 0.02;
         for (k = 0; k < 3; ++k) org[k] = (float)((uniform() - 0.5) * 12.0);
@@ -81,7 +83,13 @@ static void test_scalar_equals_simd(void **state)
             dir[2] = (float)sin(p);
             if (tile % 13 == 0) dir[i % 3] = 0.0f;
             if (tile % 17 == 0) dir[(i + 1) % 3] = -0.0f;
-            rc__ray_prepare(&r[i], org, dir);
+            if (own) {
+                float o[3];
+                for (k = 0; k < 3; ++k) o[k] = org[k] + (float)((uniform() - 0.5) * (tile % 2 ? 0.06 : 1.0));
+                rc__ray_prepare(&r[i], o, dir);
+            } else {
+                rc__ray_prepare(&r[i], org, dir);
+            }
         }
         /* single rays: scalar vs SIMD box tests */
         for (i = 0; i < RC__PACKET_SIZE; ++i) {
@@ -92,6 +100,8 @@ static void test_scalar_equals_simd(void **state)
             fa = scalar_intersect_wide(mesh, &r[i], 0, RC_INVALID_ID, &a);
             fb = rc__mesh_intersect_wide(mesh, &r[i], 0, RC_INVALID_ID, &b);
             same_hit(fa, &a, fb, &b);
+            f1[i] = fb;
+            h1[i] = b;
             assert_int_equal(scalar_occluded_wide(mesh, &r[i], 1e30f), rc__mesh_occluded_wide(mesh, &r[i], 1e30f));
             hits += (uint32_t)fa;
             ++rays;
@@ -102,9 +112,12 @@ static void test_scalar_equals_simd(void **state)
             hit_init(&hv[i]);
             fs[i] = fv[i] = 0;
         }
-        scalar_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hs, fs);
-        rc__mesh_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hv, fv);
-        for (i = 0; i < RC__PACKET_SIZE; ++i) same_hit(fs[i], &hs[i], fv[i], &hv[i]);
+        scalar_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hs, fs, own);
+        rc__mesh_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hv, fv, own);
+        for (i = 0; i < RC__PACKET_SIZE; ++i) {
+            same_hit(fs[i], &hs[i], fv[i], &hv[i]);
+            same_hit(f1[i], &h1[i], fv[i], &hv[i]); /* and the single ray's */
+        }
     }
     assert_int_equal(hits, rays); /* inside a closed sphere: every ray hits */
     rc_context_destroy(ctx);

@@ -2,7 +2,8 @@
  * single-ray search of the whole scene (rc__scene_intersect): packets mesh by
  * mesh on a scene of several meshes (duplicate meshes make every hit on them
  * a tie the lower geometry id must win), packets and OnDn single rays taking
- * turns on a map above the large-mesh threshold, and both again with two
+ * turns on a map above the large-mesh threshold, OnDn packets (origins a few
+ * centimetres apart, like a multi-beam LiDAR's), and all again with two
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
  * instance. (test_packet.c and test_wide.c check the traversals bit for bit;
@@ -102,30 +103,45 @@ static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_m
     return rct_scene_instanced(ctx, parts, 3u, *src, at, 2u);
 }
 
+static rc_sensor *make_ondn(rc_context *ctx, const float *dirs, const float *orgs, uint32_t rays)
+{
+    rc_rays_desc d = rc_rays_desc_default();
+    rc_sensor *s = NULL;
+    d.common.range_min = RANGE_MIN;
+    d.common.range_max = RANGE_MAX;
+    d.directions = dirs;
+    d.origins = orgs;
+    d.ray_count = rays;
+    RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &s));
+    return s;
+}
+
+/* orgs: origins up to 5 m apart (single rays); beams: up to 6 cm apart
+ * (packets, whose box tests grow by their spread) */
 static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,
-                      const float *dirs, const float *orgs, uint32_t rays)
+                      const float *dirs, const float *orgs, const float *beams, uint32_t rays)
 {
     uint32_t threads;
     for (threads = 1; threads <= 2; ++threads) {
         rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 128);
         rc_scene *scene, *src;
-        rc_rays_desc d = rc_rays_desc_default();
-        rc_sensor *o1dn, *ondn = NULL;
+        rc_sensor *o1dn, *ondn, *ondn_beams;
         assert_true(ctx->large_mesh_bytes >= RC__LARGE_MESH_BYTES);
         ctx->large_mesh_bytes = large_bytes;
         scene = make_scene(ctx, sphere, box, boxes, &src);
         assert_int_equal(rc__mesh_is_large(&scene->geoms[0].mesh, large_bytes), large_bytes == RC__LARGE_MESH_BYTES);
         o1dn = rct_sensor_dirs(ctx, dirs, rays, RANGE_MIN, RANGE_MAX);
-        d.common.range_min = RANGE_MIN;
-        d.common.range_max = RANGE_MAX;
-        d.directions = dirs;
-        d.origins = orgs;
-        d.ray_count = rays;
-        RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &ondn));
+        ondn = make_ondn(ctx, dirs, orgs, rays);
+        ondn_beams = make_ondn(ctx, dirs, beams, rays);
+        assert_true(ondn->origin_spread2 > RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);
+        assert_true(ondn_beams->origin_spread2 > 0.0f &&
+                    ondn_beams->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);
         check_sensor(ctx, scene, o1dn, rays);
         check_sensor(ctx, scene, ondn, rays);
+        check_sensor(ctx, scene, ondn_beams, rays);
         rc_sensor_destroy(o1dn);
         rc_sensor_destroy(ondn);
+        rc_sensor_destroy(ondn_beams);
         rc_scene_destroy(scene);
         if (src) rc_scene_destroy(src);
         rc_context_destroy(ctx);
@@ -139,11 +155,13 @@ static void test_simulate_paths(void **state)
     const uint32_t rays = 1003u;
     const float lo[3] = {2.0f, -3.0f, -2.0f}, hi[3] = {6.0f, 3.0f, 2.0f};
     float *dirs = (float *)malloc(sizeof(float) * 3u * rays), *orgs = (float *)malloc(sizeof(float) * 3u * rays);
+    float *beams = (float *)malloc(sizeof(float) * 3u * rays);
     rcu_mesh sphere, box;
     uint32_t i, k;
     (void)state;
     assert_non_null(dirs);
     assert_non_null(orgs);
+    assert_non_null(beams);
     /* 2 x 560 x 280 = 313,600 triangles: above the threshold's floor */
     assert_int_equal(rcu_mesh_uv_sphere(20.0f, 560, 280, &sphere), 0);
     assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
@@ -154,19 +172,23 @@ static void test_simulate_paths(void **state)
         dirs[3 * i] = (float)(cos(pitch) * cos(yaw));
         dirs[3 * i + 1] = (float)(cos(pitch) * sin(yaw));
         dirs[3 * i + 2] = (float)sin(pitch);
-        for (k = 0; k < 3; ++k) orgs[3 * i + k] = (float)((uniform() - 0.5) * 10.0);
+        for (k = 0; k < 3; ++k) {
+            orgs[3 * i + k] = (float)((uniform() - 0.5) * 10.0);
+            beams[3 * i + k] = (float)((uniform() - 0.5) * 0.06);
+        }
     }
     /* turns (the floor makes the sphere large), then plain packets */
-    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 0, dirs, orgs, rays);
-    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 1, dirs, orgs, rays);
-    run_paths(&sphere, &box, UINT64_MAX, 1, dirs, orgs, rays);
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 0, dirs, orgs, beams, rays);
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 1, dirs, orgs, beams, rays);
+    run_paths(&sphere, &box, UINT64_MAX, 1, dirs, orgs, beams, rays);
     /* instances after packets and runs, taking turns or not */
-    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 2, dirs, orgs, rays);
-    run_paths(&sphere, &box, UINT64_MAX, 2, dirs, orgs, rays);
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 2, dirs, orgs, beams, rays);
+    run_paths(&sphere, &box, UINT64_MAX, 2, dirs, orgs, beams, rays);
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&box);
     free(dirs);
     free(orgs);
+    free(beams);
 }
 
 int main(void)

@@ -327,7 +327,17 @@ rc_status rc_sensor_create_rays(rc_context *ctx, uint32_t model, const rc_rays_d
         o[1] = (float)(y / n);
         o[2] = (float)(z / n);
     }
-    if (s->origins) memcpy(s->origins, desc->origins, (size_t)desc->ray_count * 3u * sizeof(float));
+    s->origin_spread2 = 0.0f;
+    if (s->origins) {
+        memcpy(s->origins, desc->origins, (size_t)desc->ray_count * 3u * sizeof(float));
+        for (i = 1; i < desc->ray_count; ++i) {
+            /* origins are checked finite and within reach: no overflow */
+            const float *o = s->origins + (size_t)i * 3u;
+            const float dx = o[0] - s->origins[0], dy = o[1] - s->origins[1], dz = o[2] - s->origins[2];
+            const float d2 = dx * dx + dy * dy + dz * dz;
+            s->origin_spread2 = d2 > s->origin_spread2 ? d2 : s->origin_spread2;
+        }
+    }
     sensor_link(ctx, s);
     *out = s;
     return RC_OK;

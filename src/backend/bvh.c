@@ -40,6 +40,7 @@ typedef struct sim_run {
     uint32_t slices;                 /* tasks per pose */
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
+    int own_origins;                 /* 1 when each ray has its own origin (OnDn) */
     uint32_t in_flight;              /* tiles traced at once: RC__PACKETS_IN_FLIGHT with a large mesh, else 1 */
     int rays_by_mesh;                /* 1 when single rays go mesh by mesh, taking turns in large ones */
     uint32_t chunk_poses;            /* ordered runs: poses a task */
@@ -127,9 +128,10 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
             if (group > 1 && ((run->large >> g) & 1u)) {
-                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound);
+                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, run->own_origins);
             } else {
-                for (k = 0; k < group; ++k) rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k]);
+                for (k = 0; k < group; ++k)
+                    rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k], run->own_origins);
             }
         }
     } else if (run->rays_by_mesh) {
@@ -320,11 +322,13 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     run.job = job;
     choose_tiling(s, &run.tl);
     run.tiles = run.tl.grid_rows * run.tl.grid_cols;
-    /* Packets need one shared origin (instances are searched ray by ray
-     * after them); a scene of many meshes goes ray by ray through its
-     * top-level tree instead of testing every mesh's root per tile. */
-    run.packets = s->origins == NULL && job->scene->geom_count >= 1 &&
-                  job->scene->geom_count <= RC__PACKET_MAX_MESHES;
+    /* Packets need one shared origin, or origins close together (an OnDn
+     * sensor's beams: packet.c) (instances are searched ray by ray after
+     * them); a scene of many meshes goes ray by ray through its top-level
+     * tree instead of testing every mesh's root per tile. */
+    run.own_origins = s->origins != NULL;
+    run.packets = (s->origins == NULL || s->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD) &&
+                  job->scene->geom_count >= 1 && job->scene->geom_count <= RC__PACKET_MAX_MESHES;
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif

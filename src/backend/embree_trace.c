@@ -44,6 +44,7 @@
  *   meeting the same part of the map run back to back (+79% on the
  *   10M-triangle sphere). A batch then holds hits of several poses. */
 #include "backend/embree_impl.h"
+#include "bvh/intersect.h"
 #include "core/work_order.h"
 
 #include <float.h>
@@ -112,6 +113,24 @@ typedef struct hit_batch {
     rc__hit hit[BATCH_RAYS];
 } hit_batch;
 
+/* Prefetches what rc__scene_hit_distance_d and rc__scene_hit_normal read for
+ * an Embree hit, in two stages: stage 0 its triangle's index triple in the
+ * mesh's own array (Embree's hits have no leaf slot), stage 1 its three
+ * vertices (this reads the triple, so run stage 0 well before). Here, beside
+ * its only user, and not in the static core, which never needs it. */
+static void hit_prefetch(const rc_scene *scene, const rc__hit *hit, int stage)
+{
+    const rc__mesh *mesh = hit->inst == RC_INVALID_ID ? &scene->geoms[hit->geom].mesh
+                                                      : &scene->insts[hit->inst].source->geoms[hit->geom].mesh;
+    const uint32_t *tri = mesh->indices + (size_t)3 * hit->prim;
+    int i;
+    if (stage == 0) {
+        RC__PREFETCH(tri);
+        return;
+    }
+    for (i = 0; i < 3; ++i) RC__PREFETCH(mesh->vertices + (size_t)tri[i] * mesh->stride);
+}
+
 /* Adds ray r's hit from Embree (prefetching its index triple). */
 static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, uint32_t r, float tfar,
                              uint32_t prim, uint32_t geom, uint32_t inst)
@@ -143,7 +162,7 @@ static inline void batch_add(const trace_run *run, hit_batch *b, uint32_t pose, 
             src = (const rc__emb_scene *)run->job->scene->insts[hit->inst].source->backend_scene;
         if (src->geoms[geom].dup_count) hit->prim = rc__emb_canonical_prim(&src->geoms[geom], prim);
     }
-    if (run->prefetch) rc__scene_hit_prefetch(run->job->scene, hit, 0);
+    if (run->prefetch) hit_prefetch(run->job->scene, hit, 0);
 }
 
 /* Prefetches the vertices of every hit of a batch (their index triples were
@@ -153,7 +172,7 @@ static void batch_prefetch(const trace_run *run, const hit_batch *b)
     uint32_t i;
     if (!run->prefetch) return;
     for (i = 0; i < b->count; ++i)
-        if (b->found[i]) rc__scene_hit_prefetch(run->job->scene, &b->hit[i], 1);
+        if (b->found[i]) hit_prefetch(run->job->scene, &b->hit[i], 1);
 }
 
 /* Writes the batch's rays: entry i is of pose pose0 + b->pose[i], whose

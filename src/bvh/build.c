@@ -669,18 +669,3 @@ void rc__bvh_refit(rc__bvh *bvh, const rc__aabb *item_bounds)
         }
     }
 }
-
-double rc__bvh_sah_cost(const rc__bvh *bvh)
-{
-    /* Traversal step 1, item test 1, areas relative to the root's. */
-    double root, sum = 0.0;
-    uint32_t i;
-    if (bvh->node_count == 0) return 0.0;
-    root = rc__half_area(bvh->nodes[0].bmin, bvh->nodes[0].bmax);
-    for (i = 0; i < bvh->node_count; ++i) {
-        const rc__bvh_node *n = &bvh->nodes[i];
-        double a = rc__half_area(n->bmin, n->bmax);
-        sum += n->count ? a * (double)n->count : a;
-    }
-    return root > 0.0 ? sum / root : sum;
-}

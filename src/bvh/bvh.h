@@ -72,7 +72,4 @@ void rc__bvh_build_mt(const rc__aabb *item_bounds, uint32_t items, uint32_t leaf
 /* Recomputes every node's bounds bottom-up from new item bounds (same items). */
 void rc__bvh_refit(rc__bvh *bvh, const rc__aabb *item_bounds);
 
-/* SAH cost of the tree (for tests and quality reports). */
-double rc__bvh_sah_cost(const rc__bvh *bvh);
-
 #endif

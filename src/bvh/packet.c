@@ -7,7 +7,16 @@
  * reciprocal: 16 lanes cost a few SIMD instructions. Mixed tiles go ray by ray
  * through the single-ray traversal. Either way every ray gets exactly the hit
  * rc__mesh_intersect would give it: box tests only choose which triangles are
- * tested (conservatively), and the triangle test is the same watertight one. */
+ * tested (conservatively), and the triangle test is the same watertight one.
+ *
+ * Rays with origins of their own (an OnDn sensor whose beams leave from
+ * points a few millimetres apart, like an Ouster's) run as packets too: the
+ * broadcast test then takes the first ray's origin moved out by the lanes'
+ * largest offset along each axis, towards the near plane for entry distances
+ * and away from it for exit distances (lanes_origins). That is the test of
+ * every box grown by that offset, so it keeps every lane whose own ray meets
+ * the box; the tests of a few live lanes (few_lanes_met) and the triangle
+ * tests take each ray's own origin. */
 #include "bvh/packet.h"
 
 #include "bvh/intersect.h"
@@ -16,6 +25,7 @@
 #include "core/common.h"
 
 #include <float.h>
+#include <math.h>
 #include <stddef.h>
 
 /* On x86-64 this file is compiled twice (RC__PACKET_TWO_BUILDS, packet.h):
@@ -70,7 +80,9 @@ typedef struct packet_lanes {
     float ix[LANES], iy[LANES], iz[LANES];
     float tmax[LANES];
     uint32_t near_row[3];  /* plane row of a wide node each axis enters by (wide.h) */
-    float org[3];
+    /* the origin the broadcast tests take for near (entry) and far (exit)
+     * planes: both the rays' shared origin, or moved apart (lanes_origins) */
+    float org_near[3], org_far[3];
 } packet_lanes;
 
 
@@ -79,12 +91,12 @@ typedef struct packet_lanes {
  * that mispredicted often enough to cost more than the test. */
 static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask)
 {
-    const float nx = n->box[L->near_row[0]][c] - L->org[0];
-    const float ny = n->box[L->near_row[1]][c] - L->org[1];
-    const float nz = n->box[L->near_row[2]][c] - L->org[2];
-    const float fx = n->box[L->near_row[0] ^ 1u][c] - L->org[0];
-    const float fy = n->box[L->near_row[1] ^ 1u][c] - L->org[1];
-    const float fz = n->box[L->near_row[2] ^ 1u][c] - L->org[2];
+    const float nx = n->box[L->near_row[0]][c] - L->org_near[0];
+    const float ny = n->box[L->near_row[1]][c] - L->org_near[1];
+    const float nz = n->box[L->near_row[2]][c] - L->org_near[2];
+    const float fx = n->box[L->near_row[0] ^ 1u][c] - L->org_far[0];
+    const float fy = n->box[L->near_row[1] ^ 1u][c] - L->org_far[1];
+    const float fz = n->box[L->near_row[2] ^ 1u][c] - L->org_far[2];
     uint32_t out = 0, g;
 #if defined(RC__PACKET_SSE2)
     /* x86: rows of BOX_W lanes (four in SSE2, eight in the AVX2 build), the
@@ -191,9 +203,9 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(P->tmax);
     uint32_t k;
     for (k = 0; k < 3; ++k) {
-        const __m128 o = _mm_set1_ps(L->org[k]), lo = _mm_set1_ps(P->ilo[k]), hi = _mm_set1_ps(P->ihi[k]);
-        const __m128 pn = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k]]), o);
-        const __m128 pf = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k] ^ 1u]), o);
+        const __m128 lo = _mm_set1_ps(P->ilo[k]), hi = _mm_set1_ps(P->ihi[k]);
+        const __m128 pn = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k]]), _mm_set1_ps(L->org_near[k]));
+        const __m128 pf = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k] ^ 1u]), _mm_set1_ps(L->org_far[k]));
         t0 = _mm_max_ps(_mm_min_ps(_mm_mul_ps(pn, lo), _mm_mul_ps(pn, hi)), t0);
         t1 = _mm_min_ps(_mm_max_ps(_mm_mul_ps(pf, lo), _mm_mul_ps(pf, hi)), t1);
     }
@@ -203,9 +215,9 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vdupq_n_f32(P->tmax);
     uint32_t k;
     for (k = 0; k < 3; ++k) {
-        const float32x4_t o = vdupq_n_f32(L->org[k]), lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
-        const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), o);
-        const float32x4_t pf = vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), o);
+        const float32x4_t lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
+        const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), vdupq_n_f32(L->org_near[k]));
+        const float32x4_t pf = vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), vdupq_n_f32(L->org_far[k]));
         const float32x4_t a = vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi));
         const float32x4_t b = vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi));
         /* selects, as in box_mask: a NaN (0 * inf) imposes nothing, where
@@ -220,7 +232,8 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     for (c = 0; c < 4; ++c) {
         float t0 = 0.0f, t1 = P->tmax;
         for (k = 0; k < 3; ++k) {
-            const float pn = n->box[L->near_row[k]][c] - L->org[k], pf = n->box[L->near_row[k] ^ 1u][c] - L->org[k];
+            const float pn = n->box[L->near_row[k]][c] - L->org_near[k];
+            const float pf = n->box[L->near_row[k] ^ 1u][c] - L->org_far[k];
             const float a = pn * P->ilo[k], b = pn * P->ihi[k], d = pf * P->ilo[k], e = pf * P->ihi[k];
             const float lo = a < b ? a : b, hi = d > e ? d : e;
             t0 = lo > t0 ? lo : t0;
@@ -255,11 +268,12 @@ static RC__FORCE_INLINE uint32_t lowest_lane(uint32_t mask)
 
 /* The lanes of mask (at most FEW_LANES), each against the four children of
  * n: met[c] gets the lanes that meet child c, the same bits box_mask gives
- * (the same operations in the same order), tn[c] the nearest of their entry
+ * (the same operations in the same order, from each ray's own origin), tn[c]
+ * the nearest of their entry
  * distances (a lower bound for every lane, as packet_entry.tmin needs).
  * Returns the children some lane meets. */
-static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, uint32_t mask,
-                                              uint32_t met[4], float tn[4])
+static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, const rc__ray *rays,
+                                              uint32_t mask, uint32_t met[4], float tn[4])
 {
     uint32_t any = 0, c;
     int first = 1;
@@ -273,7 +287,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
         inv[2] = L->iz[lane];
         /* the first lane's entry distances go straight to tn (a select
          * there, on a flag, measured as a mispredicted branch per child) */
-        h = rc__wide_box_test(n, L->near_row, L->org, inv, L->tmax[lane], first ? tn : tl);
+        h = rc__wide_box_test(n, L->near_row, rays[lane].org, inv, L->tmax[lane], first ? tn : tl);
         any |= h;
         for (c = 0; c < 4; ++c) {
             met[c] |= ((h >> c) & 1u) << lane;
@@ -349,7 +363,7 @@ static int octant_of(const rc__ray *r)
 /* A tile that straddles an axis plane: one packet per octant present (a ray
  * alone goes through the single-ray traversal). */
 static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                            rc__hit *hits, int *found)
+                            rc__hit *hits, int *found, int own_origins)
 {
     uint32_t done = 0, i;
     while (done != (n >= 32u ? 0xFFFFFFFFu : (1u << n) - 1u)) {
@@ -372,7 +386,7 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
         if (m == 1) {
             sub_found[0] = rc__mesh_intersect(mesh, &sub[0], geom, inst, &sub_hits[0]);
         } else {
-            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found, own_origins);
         }
         for (i = 0; i < m; ++i) {
             hits[idx[i]] = sub_hits[i];
@@ -452,16 +466,12 @@ static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, ui
     for (k = 1; k < 4; ++k) P->tmax = t4[k] > P->tmax ? t4[k] : P->tmax;
     for (k = 0; k < 3; ++k) {
         L->near_row[k] = 2u * k + (uint32_t)((neg >> k) & 1);
-        L->org[k] = rays[0].org[k];
         P->ilo[k] = l4[k];
         P->ihi[k] = h4[k];
     }
 #else
     if (!one_octant(rays, n, L->near_row)) return 0;
-    for (k = 0; k < 3; ++k) {
-        L->org[k] = rays[0].org[k];
-        P->ilo[k] = P->ihi[k] = rays[0].inv_dir[k];
-    }
+    for (k = 0; k < 3; ++k) P->ilo[k] = P->ihi[k] = rays[0].inv_dir[k];
     P->tmax = hits[0].t;
     for (i = 0; i < n; ++i) {
         const float *inv = rays[i].inv_dir;
@@ -493,13 +503,41 @@ static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, ui
     return 1;
 }
 
+/* L->org_near and org_far (see the top; L->near_row set): rays[0]'s origin,
+ * or with own_origins each axis moved by the lanes' largest offset from it,
+ * grown by 2^-10 of itself and 2^-20 of the coordinate: more than the
+ * roundings of the offset and of the moved coordinate, so the box the test
+ * stands for holds every lane's own box. */
+static void lanes_origins(packet_lanes *L, const rc__ray *rays, uint32_t n, int own_origins)
+{
+    uint32_t i, k;
+    for (k = 0; k < 3; ++k) {
+        const float o = rays[0].org[k];
+        float d = 0.0f;
+        if (own_origins)
+            for (i = 1; i < n; ++i) {
+                const float e = fabsf(rays[i].org[k] - o);
+                d = e > d ? e : d;
+            }
+        if (d == 0.0f) {
+            L->org_near[k] = L->org_far[k] = o;
+            continue;
+        }
+        d += d * 0x1p-10f + fabsf(o) * 0x1p-20f;
+        if (L->near_row[k] & 1u) d = -d; /* towards -k: entering by the max plane */
+        L->org_near[k] = o + d;
+        L->org_far[k] = o - d;
+    }
+}
+
 /* Starts T on the root. 0 when the packet cannot run as one (empty, too
  * large, mixed octants, no tree): the caller takes the rays another way. */
 static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
-                     int *found)
+                     int *found, int own_origins)
 {
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
     if (!lanes_fill(&T->L, &T->P, rays, n, hits)) return 0;
+    lanes_origins(&T->L, rays, n, own_origins);
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     T->rays = rays;
     T->hits = hits;
@@ -556,7 +594,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         if (rest == 0) {
             /* at most FEW_LANES live lanes: each meets the four boxes at once
              * (the single-ray test), cheaper than every box over all lanes */
-            maybe = few_lanes_met(nd, L, mask, lanes_met, tn);
+            maybe = few_lanes_met(nd, L, T->rays, mask, lanes_met, tn);
         } else {
             maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
         }
@@ -664,7 +702,7 @@ next:
 }
 
 void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                                              uint32_t inst, rc__hit *hits, int *found)
+                                              uint32_t inst, rc__hit *hits, int *found, int own_origins)
 {
     packet_trav T;
     uint32_t i;
@@ -674,8 +712,8 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
         return;
     }
     if (mesh->wide_count == 0) return;
-    if (!trav_init(&T, mesh, rays, n, hits, found)) {
-        split_by_octant(mesh, rays, n, geom, inst, hits, found);
+    if (!trav_init(&T, mesh, rays, n, hits, found, own_origins)) {
+        split_by_octant(mesh, rays, n, geom, inst, hits, found, own_origins);
         return;
     }
     while (trav_step(&T, mesh, geom, inst, 0)) {
@@ -684,20 +722,20 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
 
 void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                               int *const *found)
+                                               int *const *found, int own_origins)
 {
     packet_trav T[RC__PACKETS_IN_FLIGHT];
     uint32_t live = 0, k;
     if (packets > RC__PACKETS_IN_FLIGHT) packets = RC__PACKETS_IN_FLIGHT;
     if (packets == 1) {
-        RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0]);
+        RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0], own_origins);
         return;
     }
     for (k = 0; k < packets; ++k) {
-        if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k]))
+        if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k], own_origins))
             live |= 1u << k;
         else
-            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k]);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k], own_origins);
     }
     /* take turns: while one packet's next node or leaf is on its way from
      * memory, the others work */
@@ -709,21 +747,21 @@ void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t pa
 
 #if defined(RC__PACKET_TWO_BUILDS) && !defined(RC__PACKET_AVX2_VARIANT)
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                               uint32_t inst, rc__hit *hits, int *found)
+                               uint32_t inst, rc__hit *hits, int *found, int own_origins)
 {
     if (rc__leaf4_have_avx2())
-        rc__mesh_intersect_packet_avx2(mesh, rays, n, geom, inst, hits, found);
+        rc__mesh_intersect_packet_avx2(mesh, rays, n, geom, inst, hits, found, own_origins);
     else
-        rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found);
+        rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found, own_origins);
 }
 
 void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                int *const *found)
+                                int *const *found, int own_origins)
 {
     if (rc__leaf4_have_avx2())
-        rc__mesh_intersect_packets_avx2(mesh, packets, rays, n, geom, inst, hits, found);
+        rc__mesh_intersect_packets_avx2(mesh, packets, rays, n, geom, inst, hits, found, own_origins);
     else
-        rc__mesh_intersect_packets_sse2(mesh, packets, rays, n, geom, inst, hits, found);
+        rc__mesh_intersect_packets_sse2(mesh, packets, rays, n, geom, inst, hits, found, own_origins);
 }
 #endif

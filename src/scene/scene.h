@@ -114,13 +114,6 @@ static inline int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray,
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
                                 const float dir_s[3], const float *org_s);
 
-/* Prefetches what rc__scene_hit_distance_d and rc__scene_hit_normal read for
- * a hit, in two stages: stage 0 its triangle's index triple, stage 1 its three
- * vertices (this reads the triple, so run stage 0 well before). Backends whose
- * traversal does not touch the mesh's own arrays (Embree keeps its own copy)
- * run both over a batch of hits before writing them, so the misses overlap. */
-void rc__scene_hit_prefetch(const rc_scene *scene, const rc__hit *hit, int stage);
-
 /* Unit geometric normal of a hit, in the scene's frame. */
 void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3]);
 

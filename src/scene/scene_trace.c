@@ -127,19 +127,6 @@ static const uint32_t *hit_triangle(const rc__mesh *mesh, const rc__hit *hit)
                                                          : mesh->indices + (size_t)3 * hit->prim;
 }
 
-void rc__scene_hit_prefetch(const rc_scene *scene, const rc__hit *hit, int stage)
-{
-    const rc__xformf *x;
-    const rc__mesh *mesh = hit_mesh(scene, hit, &x);
-    const uint32_t *tri = hit_triangle(mesh, hit);
-    int i;
-    if (stage == 0) {
-        RC__PREFETCH(tri);
-        return;
-    }
-    for (i = 0; i < 3; ++i) RC__PREFETCH(mesh->vertices + (size_t)tri[i] * mesh->stride);
-}
-
 /* r * (px, py, pz) in double, r row-major 3x3 (force-inlined: the results
  * stay in registers). */
 static RC__FORCE_INLINE void rot_d(const double r[9], double px, double py, double pz, double *x, double *y,

@@ -19,6 +19,7 @@ struct rc_sensor {
     rc__xform mount_xform;
     float *directions;       /* 3 * rays, unit, sensor frame, in scan order */
     float *origins;          /* 3 * rays for OnDn, else NULL */
+    float origin_spread2;    /* OnDn: largest squared distance of an origin from the first (m^2); else 0 */
     /* O1Dn/OnDn: the order the CPU backends trace the rays in (ray index in
      * the low 32 bits, its key above: ray_order.c), so that neighbours in a
      * run leave from near each other in near directions; NULL for grids,
