@@ -103,19 +103,6 @@ static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_m
     return rct_scene_instanced(ctx, parts, 3u, *src, at, 2u);
 }
 
-static rc_sensor *make_ondn(rc_context *ctx, const float *dirs, const float *orgs, uint32_t rays)
-{
-    rc_rays_desc d = rc_rays_desc_default();
-    rc_sensor *s = NULL;
-    d.common.range_min = RANGE_MIN;
-    d.common.range_max = RANGE_MAX;
-    d.directions = dirs;
-    d.origins = orgs;
-    d.ray_count = rays;
-    RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &s));
-    return s;
-}
-
 /* orgs: origins up to 5 m apart (single rays); beams: up to 6 cm apart
  * (packets, whose box tests grow by their spread) */
 static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t large_bytes, int boxes,
@@ -131,8 +118,8 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
         scene = make_scene(ctx, sphere, box, boxes, &src);
         assert_int_equal(rc__mesh_is_large(&scene->geoms[0].mesh, large_bytes), large_bytes == RC__LARGE_MESH_BYTES);
         o1dn = rct_sensor_dirs(ctx, dirs, rays, RANGE_MIN, RANGE_MAX);
-        ondn = make_ondn(ctx, dirs, orgs, rays);
-        ondn_beams = make_ondn(ctx, dirs, beams, rays);
+        ondn = rct_sensor_rays(ctx, dirs, orgs, rays, RANGE_MIN, RANGE_MAX);
+        ondn_beams = rct_sensor_rays(ctx, dirs, beams, rays, RANGE_MIN, RANGE_MAX);
         assert_true(ondn->origin_spread2 > RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);
         assert_true(ondn_beams->origin_spread2 > 0.0f &&
                     ondn_beams->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);

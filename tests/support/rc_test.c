@@ -209,16 +209,23 @@ rc_scene *rct_scene_instanced(rc_context *ctx, const rcu_mesh *const *meshes, ui
     return scene;
 }
 
-rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax)
+rc_sensor *rct_sensor_rays(rc_context *ctx, const float *dirs, const float *origins, uint32_t n, float rmin,
+                           float rmax)
 {
     rc_rays_desc d = rc_rays_desc_default();
     rc_sensor *s = NULL;
     d.common.range_min = rmin;
     d.common.range_max = rmax;
     d.directions = dirs;
+    d.origins = origins;
     d.ray_count = n;
-    RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_O1DN, &d, &s));
+    RCT_OK(ctx, rc_sensor_create_rays(ctx, origins ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &d, &s));
     return s;
+}
+
+rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax)
+{
+    return rct_sensor_rays(ctx, dirs, NULL, n, rmin, rmax);
 }
 
 double rct_ray_plane_t(const double o[3], const double d[3], const float v0[3], const float v1[3], const float v2[3])

@@ -53,6 +53,9 @@ void rct_check_budget(uint32_t backend, uint32_t preset, uint32_t rays);
 
 /* O1Dn sensor over n directions (copied), range [rmin, rmax]. */
 rc_sensor *rct_sensor_dirs(rc_context *ctx, const float *dirs, uint32_t n, float rmin, float rmax);
+/* The same with an origin per ray (OnDn; O1Dn where origins is NULL). */
+rc_sensor *rct_sensor_rays(rc_context *ctx, const float *dirs, const float *origins, uint32_t n, float rmin,
+                           float rmax);
 
 /* Exact (double) intersection distance of a ray with a triangle's plane. */
 double rct_ray_plane_t(const double org[3], const double dir[3], const float v0[3], const float v1[3],
