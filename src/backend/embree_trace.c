@@ -44,7 +44,7 @@
  *   meeting the same part of the map run back to back (+79% on the
  *   10M-triangle sphere). A batch then holds hits of several poses. */
 #include "backend/embree_impl.h"
-#include "bvh/intersect.h"
+#include "bvh/packet.h" /* RC__PACKET_ORIGIN_SPREAD; RC__PREFETCH */
 #include "core/work_order.h"
 
 #include <float.h>
@@ -460,7 +460,9 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
     run.tiles_x = (run.grid_cols + run.tile_cols - 1u) / run.tile_cols;
     tiles_y = (run.grid_rows + run.tile_rows - 1u) / run.tile_rows;
     run.tiles_per_pose = run.tiles_x * tiles_y;
-    run.coherent = sensor->origins == NULL;
+    /* one origin, or a multi-beam LiDAR's beams (as the built-in backend's packets) */
+    run.coherent = sensor->origins == NULL ||
+                   sensor->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD;
     run.slices = 1;
     /* Few poses: cut each scan into slices (of whole tiles) so every thread has work. */
     if (threads > 1 && job->pose_count < threads * 4u) {
