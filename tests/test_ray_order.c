@@ -1,6 +1,7 @@
 /* The trace order of O1Dn/OnDn sensors (src/sensor/ray_order.c): a
  * permutation of the rays, sorted by its key, with rays of one key cell
- * together; grids have none; and the order changes no result: the same rays
+ * together; grids have none, nor have rays given in rows (traced in tiles of
+ * their scan order); and the order changes no result: the same rays
  * given in another order give, ray for ray, the same bits on every CPU
  * backend (white-box: includes sensor/sensor.h). */
 #include <math.h>
@@ -17,7 +18,8 @@
  * in a 2 m ball, directions anywhere. */
 static void random_rays(float *org, float *dir) { rcu_rays_random(RAYS, 2.0f, 11u, org, dir); }
 
-static rc_sensor *ondn(rc_context *ctx, const float *org, const float *dir)
+/* An OnDn sensor of the RAYS rays, flat (width 0) or in rows of width. */
+static rc_sensor *ondn_shaped(rc_context *ctx, const float *org, const float *dir, uint32_t width)
 {
     rc_rays_desc d = rc_rays_desc_default();
     rc_sensor *s = NULL;
@@ -26,9 +28,13 @@ static rc_sensor *ondn(rc_context *ctx, const float *org, const float *dir)
     d.directions = dir;
     d.origins = org;
     d.ray_count = RAYS;
+    d.width = width;
+    d.height = width ? RAYS / width : 0u;
     RCT_OK(ctx, rc_sensor_create_rays(ctx, RC_SENSOR_ONDN, &d, &s));
     return s;
 }
+
+static rc_sensor *ondn(rc_context *ctx, const float *org, const float *dir) { return ondn_shaped(ctx, org, dir, 0u); }
 
 static void test_order_is_a_sorted_permutation(void **state)
 {
@@ -59,6 +65,24 @@ static void test_order_is_a_sorted_permutation(void **state)
     RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &grid));
     assert_null(grid->trace_order);
     assert_int_equal(rc__sensor_traced_ray(grid, 77), 77);
+    {
+        /* rays in rows (60 x 50): scan order, cut into tiles by the steps
+         * between the centre ray and its neighbours; a flat list has none */
+        rc_sensor *rows = ondn_shaped(ctx, org, dir, 50u);
+        double dv = 0.0, dh = 0.0;
+        const uint32_t centre = 29u * 50u + 24u;
+        const float *c = rows->directions + 3u * centre, *below = c + 3u * 50u, *right = c + 3u;
+        const double h2 = (double)c[0] * c[0] + (double)c[1] * c[1];
+        assert_null(rows->trace_order);
+        assert_int_equal(rc__sensor_traced_ray(rows, 77), 77);
+        assert_int_equal(rc__sensor_grid_steps(rows, &dv, &dh), 1);
+        /* the sines of the elevation and azimuth steps */
+        assert_true(dv == fabs((double)below[2] - c[2]));
+        assert_true(fabs(dh - fabs((double)c[0] * right[1] - (double)c[1] * right[0]) / h2) < 1e-15);
+        assert_int_equal(rc__sensor_grid_steps(s, &dv, &dh), 0);
+        assert_int_equal(rc__sensor_grid_steps(grid, &dv, &dh), 1);
+        assert_true(fabs(dv - 2.0 * 3.14159265358979 / 180.0) < 1e-6 && fabs(dh - 0.4 * 3.14159265358979 / 180.0) < 1e-6);
+    }
     rc_context_destroy(ctx);
     free(org);
     free(dir);
@@ -66,7 +90,9 @@ static void test_order_is_a_sorted_permutation(void **state)
 }
 
 /* The rays reversed make another trace order of the same rays (ties of a key
- * cell go by index): every attribute of ray i equals that of ray N-1-i. */
+ * cell go by index): every attribute of ray i equals that of ray N-1-i. The
+ * same rays given in rows (no sort: tiles of the scan order) give ray i's
+ * attributes bit for bit too. */
 static void check_order_free(uint32_t backend)
 {
     rcu_mesh sphere;
@@ -74,8 +100,8 @@ static void check_order_free(uint32_t backend)
     float *org = (float *)malloc(sizeof(float) * 3u * RAYS), *dir = (float *)malloc(sizeof(float) * 3u * RAYS);
     float *rorg = (float *)malloc(sizeof(float) * 3u * RAYS), *rdir = (float *)malloc(sizeof(float) * 3u * RAYS);
     rc_scene *scene;
-    rc_sensor *a, *b;
-    rct_buffers x, y;
+    rc_sensor *a, *b, *c;
+    rct_buffers x, y, z;
     rc_pose p = rct_pose_ypr(0.3f, -0.2f, 0.1f, 0.4, 0.1, -0.2);
     uint32_t i;
     assert_int_equal(rcu_mesh_uv_sphere(10.0f, 96, 48, &sphere), 0);
@@ -87,12 +113,19 @@ static void check_order_free(uint32_t backend)
     }
     a = ondn(ctx, org, dir);
     b = ondn(ctx, rorg, rdir);
+    c = ondn_shaped(ctx, org, dir, 50u);
     rct_buffers_alloc(&x, RAYS, RC_ATTR_ALL);
     rct_buffers_alloc(&y, RAYS, RC_ATTR_ALL);
+    rct_buffers_alloc(&z, RAYS, RC_ATTR_ALL);
     RCT_OK(ctx, rc_simulate(ctx, scene, a, &p, 1, &x.res));
     RCT_OK(ctx, rc_simulate(ctx, scene, b, &p, 1, &y.res));
+    RCT_OK(ctx, rc_simulate(ctx, scene, c, &p, 1, &z.res));
     for (i = 0; i < RAYS; ++i) {
         const uint32_t j = RAYS - 1u - i;
+        assert_int_equal(x.res.hits[i], z.res.hits[i]);
+        assert_memory_equal(&x.res.ranges[i], &z.res.ranges[i], sizeof(float));
+        assert_memory_equal(&x.res.normals[3u * i], &z.res.normals[3u * i], 3 * sizeof(float));
+        assert_int_equal(x.res.prim_ids[i], z.res.prim_ids[i]);
         assert_int_equal(x.res.hits[i], y.res.hits[j]);
         assert_memory_equal(&x.res.ranges[i], &y.res.ranges[j], sizeof(float));
         assert_memory_equal(&x.res.points[3u * i], &y.res.points[3u * j], 3 * sizeof(float));
@@ -102,6 +135,7 @@ static void check_order_free(uint32_t backend)
     assert_int_equal(x.res.hits[0], 1); /* inside a closed sphere every ray hits */
     rct_buffers_free(&x);
     rct_buffers_free(&y);
+    rct_buffers_free(&z);
     rc_context_destroy(ctx);
     rcu_mesh_free(&sphere);
     free(org);

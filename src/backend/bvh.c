@@ -57,18 +57,7 @@ static void choose_tiling(const rc_sensor *s, tiling *tl)
 {
     double row_step = 1.0, col_step = 1.0, best = 1e300;
     uint32_t tr;
-    if (s->model == RC_SENSOR_SPHERICAL) {
-        row_step = fabs(s->spherical.phi.increment);
-        col_step = fabs(s->spherical.theta.increment);
-    } else if (s->model == RC_SENSOR_CYLINDRICAL) {
-        row_step = 1.0 / s->cylindrical.fy;
-        col_step = fabs(s->cylindrical.theta.increment);
-    } else if (s->model == RC_SENSOR_PINHOLE) {
-        row_step = 1.0 / s->pinhole.fy;
-        col_step = 1.0 / s->pinhole.fx;
-    } else {
-        row_step = 1e9; /* O1Dn/OnDn: runs of consecutive rays */
-    }
+    if (!rc__sensor_grid_steps(s, &row_step, &col_step)) row_step = 1e9; /* flat rays: runs of 16 */
     tl->tile_rows = 1;
     for (tr = 1; tr <= RC__PACKET_SIZE; tr *= 2) {
         uint32_t tc = RC__PACKET_SIZE / tr;

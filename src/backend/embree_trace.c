@@ -3,11 +3,12 @@
  * nearby directions and Embree's packet traversal visits each node once for
  * all of them.
  *
- * - Grid sensors (spherical, pinhole, cylindrical) are cut into tiles of
+ * - Grid sensors (spherical, pinhole, cylindrical, and O1Dn/OnDn rays given
+ *   in rows, such as an Ouster unit's) are cut into tiles of
  *   rows x columns whose angular extent is closest to square (a VLP-16, with
  *   rows 5x farther apart than columns, gets 1 x 8; a depth camera 2 x 4);
- *   O1Dn and OnDn into runs of consecutive rays (the scan order of a rosette
- *   or a user pattern keeps neighbours together). Partial tiles at the edges
+ *   other O1Dn and OnDn rays into runs of consecutive rays of their traced
+ *   order (sorted by direction and origin, ray_order.c). Partial tiles at the edges
  *   leave lanes off. Packets go with Embree's coherent flag: it measured ~20%
  *   faster than incoherent on robust scenes.
  * - Tasks are a pose, or a slice of a pose's tiles when there are fewer poses
@@ -363,38 +364,18 @@ static uint32_t pick_width(const rc__emb_device *d)
     return w;
 }
 
-/* Angular step between neighbouring rows (dv) and columns (dh) of a grid
- * sensor, at its centre. */
-static void grid_steps(const rc_sensor *sensor, double *dv, double *dh)
-{
-    switch (sensor->model) {
-    case RC_SENSOR_SPHERICAL:
-        *dv = fabs((double)sensor->spherical.phi.increment);
-        *dh = fabs((double)sensor->spherical.theta.increment);
-        break;
-    case RC_SENSOR_PINHOLE:
-        *dv = 1.0 / (double)sensor->pinhole.fy;
-        *dh = 1.0 / (double)sensor->pinhole.fx;
-        break;
-    default: /* cylindrical */
-        *dv = 1.0 / (double)sensor->cylindrical.fy;
-        *dh = fabs((double)sensor->cylindrical.theta.increment);
-        break;
-    }
-}
-
 /* Tile of w lanes (rows x columns) whose angular extent is closest to square,
  * never taller than the grid: a VLP-16 (2 degrees between rows, 0.4 between
- * columns) gets 1 x 8, an OS1-64 or a depth camera 2 x 4. Fewer rows on a tie. */
-static void tile_shape(const rc_sensor *sensor, uint32_t w, uint32_t rows, int grid, uint32_t *tile_rows,
+ * columns) gets 1 x 8, an OS1-64 or a depth camera 2 x 4. Fewer rows on a tie.
+ * dv, dh: the steps between rows and columns (rc__sensor_grid_steps). */
+static void tile_shape(double dv, double dh, uint32_t w, uint32_t rows, int grid, uint32_t *tile_rows,
                        uint32_t *tile_cols)
 {
-    double dv = 0.0, dh = 0.0, best = HUGE_VAL;
+    double best = HUGE_VAL;
     uint32_t r;
     *tile_rows = 1;
     *tile_cols = w;
     if (!grid || rows < 2) return;
-    grid_steps(sensor, &dv, &dh);
     if (!(dv > 0.0) || !(dh > 0.0)) return;
     for (r = 1; r <= w && r <= rows; r *= 2) {
         double cost = fabs(log((r * dv) / ((w / r) * dh)));
@@ -440,8 +421,9 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
     uint32_t threads = ctx->thread_count;
     uint32_t tiles_y;
     trace_run run;
-    int grid = sensor->model == RC_SENSOR_SPHERICAL || sensor->model == RC_SENSOR_PINHOLE ||
-               sensor->model == RC_SENSOR_CYLINDRICAL;
+    double dv = 0.0, dh = 0.0;
+    /* grid sensors, and rays given in rows (an Ouster unit's beams x columns) */
+    const int grid = rc__sensor_grid_steps(sensor, &dv, &dh);
 
     run.job = job;
     run.es = (const rc__emb_scene *)job->scene->backend_scene;
@@ -456,7 +438,7 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
     run.width = pick_width(d);
     run.grid_rows = grid ? sensor->rows : 1u;
     run.grid_cols = grid ? sensor->columns : sensor->rays;
-    tile_shape(sensor, run.width, run.grid_rows, grid, &run.tile_rows, &run.tile_cols);
+    tile_shape(dv, dh, run.width, run.grid_rows, grid, &run.tile_rows, &run.tile_cols);
     run.tiles_x = (run.grid_cols + run.tile_cols - 1u) / run.tile_cols;
     tiles_y = (run.grid_rows + run.tile_rows - 1u) / run.tile_rows;
     run.tiles_per_pose = run.tiles_x * tiles_y;

@@ -6,6 +6,8 @@
 #include "core/rmath.h"
 #include "noise/noise.h"
 
+#include <math.h>
+
 struct rc_sensor {
     uint32_t magic;
     uint32_t model;          /* RC_SENSOR_* */
@@ -50,6 +52,48 @@ size_t rc__sensor_bytes(uint32_t model, uint64_t rays);
 void rc__sensor_fill_spherical(const rc_spherical_desc *desc, float *dirs);
 void rc__sensor_fill_pinhole(const rc_pinhole_desc *desc, float *dirs);
 void rc__sensor_fill_cylindrical(const rc_cylindrical_desc *desc, float *dirs);
+
+/* 1 when the CPU backends trace the sensor in tiles of rows x columns in
+ * scan order (spherical, pinhole, cylindrical, and O1Dn/OnDn rays given with
+ * more than one row, such as an Ouster unit's beams x columns), with the
+ * angular steps between neighbouring rows and columns at the grid's centre
+ * (radians; for rays, about the sines of the elevation step between rows
+ * and the azimuth step between columns: only their ratio shapes the tiles);
+ * 0 for a flat list of rays, traced in runs of the sorted order. */
+static inline int rc__sensor_grid_steps(const rc_sensor *s, double *row_step, double *col_step)
+{
+    switch (s->model) {
+    case RC_SENSOR_SPHERICAL:
+        *row_step = fabs((double)s->spherical.phi.increment);
+        *col_step = fabs((double)s->spherical.theta.increment);
+        return 1;
+    case RC_SENSOR_PINHOLE:
+        *row_step = 1.0 / s->pinhole.fy;
+        *col_step = 1.0 / s->pinhole.fx;
+        return 1;
+    case RC_SENSOR_CYLINDRICAL:
+        *row_step = 1.0 / s->cylindrical.fy;
+        *col_step = fabs((double)s->cylindrical.theta.increment);
+        return 1;
+    default: {
+        /* rays: as for a spinning LiDAR's beams (whose rows may sit degrees
+         * apart in azimuth: an Ouster's staggered beams), the sine-like steps
+         * of elevation to the next row's ray (z, the directions being unit)
+         * and of azimuth to the next column's (the z of their cross product
+         * over the horizontal length squared), from the centre ray */
+        const float *a, *next_row;
+        double h2;
+        if (s->rows < 2u) return 0;
+        a = s->directions + (size_t)3 * ((s->rows - 1u) / 2u * s->columns + (s->columns - 1u) / 2u);
+        next_row = a + (size_t)3 * s->columns;
+        h2 = (double)a[0] * a[0] + (double)a[1] * a[1];
+        *row_step = *col_step = fabs((double)next_row[2] - a[2]);
+        if (s->columns > 1u && h2 > 1e-12) /* a[3], a[4]: the next column's x, y */
+            *col_step = fabs((double)a[0] * a[4] - (double)a[1] * a[3]) / h2;
+        return 1;
+    }
+    }
+}
 
 /* Sorts the rays of an O1Dn/OnDn sensor into s->trace_order (ray_order.c). */
 void rc__sensor_order_rays(rc_sensor *s);
