@@ -73,8 +73,22 @@ static void test_order_is_a_sorted_permutation(void **state)
         const uint32_t centre = 29u * 50u + 24u;
         const float *c = rows->directions + 3u * centre, *below = c + 3u * 50u, *right = c + 3u;
         const double h2 = (double)c[0] * c[0] + (double)c[1] * c[1];
+        rc_rays_desc flat_d = rc_rays_desc_default(), rows_d;
+        size_t flat_bytes = 0, rows_bytes = 0;
         assert_null(rows->trace_order);
         assert_int_equal(rc__sensor_traced_ray(rows, 77), 77);
+        /* no order table: 8 bytes a ray less than the flat list */
+        flat_d.common.range_min = 0.05f;
+        flat_d.common.range_max = 100.0f;
+        flat_d.directions = dir;
+        flat_d.origins = org;
+        flat_d.ray_count = RAYS;
+        rows_d = flat_d;
+        rows_d.width = 50u;
+        rows_d.height = RAYS / 50u;
+        assert_int_equal(rc_sensor_memory_requirements_rays(RC_SENSOR_ONDN, &flat_d, &flat_bytes), RC_OK);
+        assert_int_equal(rc_sensor_memory_requirements_rays(RC_SENSOR_ONDN, &rows_d, &rows_bytes), RC_OK);
+        assert_int_equal(flat_bytes - rows_bytes, 8u * RAYS);
         assert_int_equal(rc__sensor_grid_steps(rows, &dv, &dh), 1);
         /* the sines of the elevation and azimuth steps */
         assert_true(dv == fabs((double)below[2] - c[2]));

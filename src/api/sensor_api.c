@@ -1,7 +1,7 @@
 /* Public sensor functions: descriptor defaults, size queries, create/destroy,
  * info, mounting. A sensor is one arena allocation: the struct, then the
- * direction table, then (OnDn) the origin table, then (O1Dn, OnDn) the trace
- * order, each at a 16-aligned offset, so rc__sensor_bytes is exactly the
+ * direction table, then (OnDn) the origin table, then (O1Dn, OnDn given as
+ * one flat row) the trace order, each at a 16-aligned offset, so rc__sensor_bytes is exactly the
  * arena cost of that one block. */
 #include "sensor/sensor.h"
 
@@ -15,14 +15,14 @@
 typedef struct sensor_layout {
     size_t directions; /* offset of the direction table */
     size_t origins;    /* offset of the origin table (OnDn), else 0 */
-    size_t order;      /* offset of the trace order (O1Dn, OnDn), else 0 */
+    size_t order;      /* offset of the trace order (flat O1Dn, OnDn), else 0 */
     size_t total;      /* bytes of the one allocation */
 } sensor_layout;
 
 static uint64_t align16(uint64_t n) { return (n + 15u) & ~(uint64_t)15u; }
 
 /* 0 when the sensor cannot be laid out in this platform's size_t. */
-static int sensor_layout_of(uint32_t model, uint64_t rays, sensor_layout *out)
+static int sensor_layout_of(uint32_t model, uint32_t rows, uint64_t rays, sensor_layout *out)
 {
     const uint64_t table = align16(rays * 12u); /* 3 floats a ray */
     uint64_t total = align16(sizeof(struct rc_sensor));
@@ -34,7 +34,8 @@ static int sensor_layout_of(uint32_t model, uint64_t rays, sensor_layout *out)
         origins = total;
         total += table;
     }
-    if (model == RC_SENSOR_O1DN || model == RC_SENSOR_ONDN) {
+    /* rays given in rows keep their scan order (sensor_link) */
+    if ((model == RC_SENSOR_O1DN || model == RC_SENSOR_ONDN) && rows <= 1u) {
         order = total;
         total += align16(rays * 8u);
     }
@@ -47,10 +48,10 @@ static int sensor_layout_of(uint32_t model, uint64_t rays, sensor_layout *out)
     return 1;
 }
 
-size_t rc__sensor_bytes(uint32_t model, uint64_t rays)
+size_t rc__sensor_bytes(uint32_t model, uint32_t rows, uint64_t rays)
 {
     sensor_layout l;
-    if (!sensor_layout_of(model, rays, &l)) return 0;
+    if (!sensor_layout_of(model, rows, rays, &l)) return 0;
     return rc__arena_cost(l.total);
 }
 
@@ -127,7 +128,7 @@ rc_status rc_sensor_memory_requirements_spherical(const rc_spherical_desc *desc,
 {
     if (!bytes) return RC_ERR_INVALID_ARGUMENT;
     RC_TRY(rc__sensor_check_spherical(NULL, desc));
-    *bytes = rc__sensor_bytes(RC_SENSOR_SPHERICAL, (uint64_t)desc->phi.count * desc->theta.count);
+    *bytes = rc__sensor_bytes(RC_SENSOR_SPHERICAL, desc->phi.count, (uint64_t)desc->phi.count * desc->theta.count);
     return RC_OK;
 }
 
@@ -135,7 +136,7 @@ rc_status rc_sensor_memory_requirements_pinhole(const rc_pinhole_desc *desc, siz
 {
     if (!bytes) return RC_ERR_INVALID_ARGUMENT;
     RC_TRY(rc__sensor_check_pinhole(NULL, desc));
-    *bytes = rc__sensor_bytes(RC_SENSOR_PINHOLE, (uint64_t)desc->width * desc->height);
+    *bytes = rc__sensor_bytes(RC_SENSOR_PINHOLE, desc->height, (uint64_t)desc->width * desc->height);
     return RC_OK;
 }
 
@@ -143,7 +144,7 @@ rc_status rc_sensor_memory_requirements_cylindrical(const rc_cylindrical_desc *d
 {
     if (!bytes) return RC_ERR_INVALID_ARGUMENT;
     RC_TRY(rc__sensor_check_cylindrical(NULL, desc));
-    *bytes = rc__sensor_bytes(RC_SENSOR_CYLINDRICAL, (uint64_t)desc->theta.count * desc->height);
+    *bytes = rc__sensor_bytes(RC_SENSOR_CYLINDRICAL, desc->height, (uint64_t)desc->theta.count * desc->height);
     return RC_OK;
 }
 
@@ -151,7 +152,7 @@ rc_status rc_sensor_memory_requirements_rays(uint32_t model, const rc_rays_desc 
 {
     if (!bytes) return RC_ERR_INVALID_ARGUMENT;
     RC_TRY(rc__sensor_check_rays(NULL, model, desc));
-    *bytes = rc__sensor_bytes(model, desc->ray_count);
+    *bytes = rc__sensor_bytes(model, desc->height > 1u ? desc->height : 1u, desc->ray_count);
     return RC_OK;
 }
 
@@ -170,9 +171,10 @@ rc_status rc_sensor_memory_requirements_preset(uint32_t preset, size_t *bytes)
         return rc_sensor_memory_requirements_pinhole(&d, bytes);
     }
     {
+        rc_rays_desc d;
         uint32_t n = 0;
-        RC_TRY(rc_preset_rays(preset, NULL, NULL, &n));
-        *bytes = rc__sensor_bytes(model, n);
+        RC_TRY(rc_preset_rays(preset, &d, NULL, &n));
+        *bytes = rc__sensor_bytes(model, d.height > 1u ? d.height : 1u, n);
         return RC_OK;
     }
 }
@@ -202,14 +204,14 @@ static rc_status sensor_make(rc_context *ctx, uint32_t model, uint32_t rows, uin
     sensor_layout l;
     unsigned char *mem;
     rc_sensor *s;
-    if (!sensor_layout_of(model, rays, &l)) /* the checks already refuse this */
+    if (!sensor_layout_of(model, rows, rays, &l)) /* the checks already refuse this */
         return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT, "sensor of %llu rays too large", (unsigned long long)rays);
     mem = (unsigned char *)rc__arena_alloc(&ctx->arena, l.total);
     if (!mem)
         return rc__fail(ctx, RC_ERR_OUT_OF_MEMORY,
                         "sensor of %u x %u rays needs %llu bytes of arena (rc_sensor_memory_requirements_*); "
                         "the largest free block holds %llu",
-                        rows, columns, (unsigned long long)rc__sensor_bytes(model, rays),
+                        rows, columns, (unsigned long long)rc__sensor_bytes(model, rows, rays),
                         (unsigned long long)rc__arena_largest_free(&ctx->arena));
     s = (rc_sensor *)(void *)mem;
     memset(s, 0, sizeof *s);
@@ -233,13 +235,11 @@ static rc_status sensor_make(rc_context *ctx, uint32_t model, uint32_t rows, uin
 
 /* Links a filled sensor into its context (sorting a flat O1Dn/OnDn sensor's
  * rays first: their tables are complete now). O1Dn/OnDn rays given as a grid
- * of several rows keep their scan order, which the backends cut into tiles
- * (an Ouster unit's beams x columns: 2 x 8 tiles ran 5-12% faster than runs
- * of the sorted order); the order table stays reserved, so a sensor's bytes
- * depend on its model and ray count alone. */
+ * of several rows have no order table: they keep their scan order, which the
+ * backends cut into tiles (an Ouster unit's beams x columns: 2 x 8 tiles ran
+ * 5-12% faster than runs of the sorted order). */
 static void sensor_link(rc_context *ctx, rc_sensor *s)
 {
-    if (s->trace_order && s->rows > 1u) s->trace_order = NULL;
     if (s->trace_order) rc__sensor_order_rays(s);
     s->next = ctx->sensors;
     ctx->sensors = s;

@@ -30,7 +30,8 @@ rc_status rc__fail(struct rc_context *ctx, rc_status status, const char *fmt, ..
 /* Clears the last error (called at the start of public functions). */
 void rc__clear_error(struct rc_context *ctx);
 
-/* Debug/info message to the log callback, if any. */
+/* Debug/info message to the log callback, if any (built with the Vulkan
+ * backend only, its one caller: error.c). */
 void rc__log(const struct rc_context *ctx, uint32_t level, const char *fmt, ...) RC__PRINTF(3, 4);
 
 #define RC_RETURN_IF(ctx, cond, status, ...)                  \

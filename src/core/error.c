@@ -53,6 +53,10 @@ void rc__clear_error(struct rc_context *ctx)
     ctx->last_status = RC_OK;
 }
 
+#if defined(RANGECAST_WITH_VULKAN)
+/* Only the Vulkan backend logs beyond errors (rc__fail): the static core,
+ * built without it, leaves this out (its aarch64 size budget). Drop the
+ * guard when the core itself logs. */
 void rc__log(const struct rc_context *ctx, uint32_t level, const char *fmt, ...)
 {
     char buf[RC__ERROR_TEXT];
@@ -63,6 +67,7 @@ void rc__log(const struct rc_context *ctx, uint32_t level, const char *fmt, ...)
     va_end(ap);
     ctx->log(ctx->log_user, level, buf);
 }
+#endif
 
 int rc__all_finite(const float *v, size_t n)
 {

@@ -45,8 +45,9 @@ rc_status rc__sensor_check_pinhole(rc_context *ctx, const rc_pinhole_desc *desc)
 rc_status rc__sensor_check_cylindrical(rc_context *ctx, const rc_cylindrical_desc *desc);
 rc_status rc__sensor_check_rays(rc_context *ctx, uint32_t model, const rc_rays_desc *desc);
 
-/* Arena bytes of a sensor with this many rays (object + tables). */
-size_t rc__sensor_bytes(uint32_t model, uint64_t rays);
+/* Arena bytes of a sensor with this many rays in this many rows (object +
+ * tables; only a flat O1Dn/OnDn list, one row, has a trace order). */
+size_t rc__sensor_bytes(uint32_t model, uint32_t rows, uint64_t rays);
 
 /* Fill the direction table (3 floats a ray, unit) in scan order. */
 void rc__sensor_fill_spherical(const rc_spherical_desc *desc, float *dirs);

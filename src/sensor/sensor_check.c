@@ -55,7 +55,7 @@ static rc_status check_ray_count(rc_context *ctx, uint32_t model, uint64_t rows,
         return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT,
                         "desc: %llu x %llu = %llu rays, more than the 4294967295 a scan can hold",
                         (unsigned long long)rows, (unsigned long long)columns, (unsigned long long)rays);
-    if (rc__sensor_bytes(model, rays) == 0)
+    if (rc__sensor_bytes(model, 1u, rays) == 0) /* the largest layout: with a trace order */
         return rc__fail(ctx, RC_ERR_INVALID_ARGUMENT,
                         "desc: %llu rays: the direction table (%llu bytes) does not fit this platform's size_t",
                         (unsigned long long)rays, (unsigned long long)(rays * 12u));
