@@ -74,12 +74,23 @@ typedef struct rc__leaf4_soa {
 
 static RC__FORCE_INLINE void rc__leaf4_transpose(const float *const v[4][3], uint32_t count, rc__leaf4_soa *s)
 {
+#if defined(RC__LEAF4_SSE2)
+    /* each row built in a register and stored whole: the tests load rows,
+     * and a row load waits for four one-float stores to reach the cache
+     * (no store forwarding from several stores) */
+    const float *const *p0 = v[0], *const *p1 = v[count > 1u ? 1 : 0];
+    const float *const *p2 = v[count > 2u ? 2 : 0], *const *p3 = v[count > 3u ? 3 : 0];
+    uint32_t vx, k;
+    for (vx = 0; vx < 3; ++vx)
+        for (k = 0; k < 3; ++k) _mm_storeu_ps(s->c[vx][k], _mm_setr_ps(p0[vx][k], p1[vx][k], p2[vx][k], p3[vx][k]));
+#else
     uint32_t i, vx, k;
     for (i = 0; i < 4; ++i) {
         const float *const *t = v[i < count ? i : 0];
         for (vx = 0; vx < 3; ++vx)
             for (k = 0; k < 3; ++k) s->c[vx][k][i] = t[vx][k];
     }
+#endif
 }
 
 /* Four float lanes, written once for SSE2 and NEON: the lane body

@@ -275,6 +275,7 @@ static RC__FORCE_INLINE uint32_t lowest_lane(uint32_t mask)
 static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, const rc__ray *rays,
                                               uint32_t mask, uint32_t met[4], float tn[4])
 {
+    uint64_t fields = 0; /* bits 16c + lane: lane meets child c */
     uint32_t any = 0, c;
     int first = 1;
     while (mask) {
@@ -289,12 +290,19 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
          * there, on a flag, measured as a mispredicted branch per child) */
         h = rc__wide_box_test(n, L->near_row, rays[lane].org, inv, L->tmax[lane], first ? tn : tl);
         any |= h;
-        for (c = 0; c < 4; ++c) {
-            met[c] |= ((h >> c) & 1u) << lane;
-            if (!first) tn[c] = tl[c] < tn[c] ? tl[c] : tn[c];
+        /* h's bit c moved to bit 16c (h < 16: the four shifted copies do
+         * not overlap) */
+        fields |= ((uint64_t)h * 0x0000200040008001u & 0x0001000100010001u) << lane;
+        if (!first) {
+#if defined(RC__LEAF4_SSE2)
+            _mm_store_ps(tn, _mm_min_ps(_mm_load_ps(tl), _mm_load_ps(tn))); /* tl < tn ? tl : tn, NaN too */
+#else
+            for (c = 0; c < 4; ++c) tn[c] = tl[c] < tn[c] ? tl[c] : tn[c];
+#endif
         }
         first = 0;
     }
+    for (c = 0; c < 4; ++c) met[c] |= (uint32_t)(fields >> 16u * c) & 0xFFFFu;
     return any;
 }
 
@@ -650,6 +658,14 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         rc__leaf4_out lo;
         uint32_t m = mask, known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
         int shrunk = 0;
+#if defined(RC__LEAF4_SSE2)
+        if (!(m & (m - 1u))) {
+            const uint32_t lane = lowest_lane(m);
+            rc__leaf4_test(&rays[lane], (const float *const(*)[3])vt, n_tri, &lo);
+            leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, &shrunk);
+            m = 0;
+        } else
+#endif
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
         while (m) {
             const uint32_t lane = lowest_lane(m);
