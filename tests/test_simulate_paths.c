@@ -6,13 +6,15 @@
  * centimetres apart, like a multi-beam LiDAR's), and all again with two
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
- * instance. (test_packet.c and test_wide.c check the traversals bit for bit;
+ * instance. On x86 also the packets' refinement of a tile's hits two at a
+ * time, against the one-hit function. (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
  * context's threshold is set by the test, whatever this CPU's cache. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "backend/backend.h"
 #include "bvh/packet.h"
 #include "core/context.h"
 #include "poses.h"
@@ -83,6 +85,49 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
     rct_buffers_free(&buf);
 }
 
+#if defined(RC__HIT_DISTANCES_SSE2)
+/* The refinement of a tile's hits two at a time (rc__scene_hit_distances_d)
+ * against rc__scene_hit_distance_d one at a time: the same doubles, for
+ * tiles of 1..16 rays with misses and instance hits among them, under a
+ * turned pose. */
+static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t rays)
+{
+    const rc_pose pose = rct_pose_ypr(0.5f, -1.0f, 0.3f, 0.9, -0.3, 0.2);
+    rc__xformf world;
+    rc__hit hits[RC__PACKET_SIZE];
+    int found[RC__PACKET_SIZE];
+    uint32_t idx[RC__PACKET_SIZE];
+    double td[RC__PACKET_SIZE];
+    uint32_t at = 0, n = 1, i, pairs = 0, insts = 0;
+    rc__sensor_world_xform(s, &pose, &world);
+    while (at + n <= rays) {
+        for (i = 0; i < n; ++i) {
+            const float *d = s->directions + 3u * (at + i);
+            float dw[3];
+            rc__ray r;
+            idx[i] = at + i;
+            rc__rot_apply_f(world.r, d, dw);
+            rc__ray_prepare(&r, world.t, dw);
+            hits[i].t = RANGE_MAX;
+            hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
+            found[i] = (at + i) % 7u != 3u && rc__scene_intersect(scene, &r, &hits[i]);
+            insts += found[i] && hits[i].inst != RC_INVALID_ID;
+        }
+        rc__scene_hit_distances_d(scene, hits, found, n, &world, s->directions, idx, td);
+        for (i = 0; i < n; ++i) {
+            const double want =
+                found[i] ? rc__scene_hit_distance_d(scene, &hits[i], &world, s->directions + 3u * idx[i], NULL) : 0.0;
+            assert_memory_equal(&td[i], &want, sizeof want);
+            pairs += found[i];
+        }
+        at += n;
+        n = n % RC__PACKET_SIZE + 1u;
+    }
+    assert_true(pairs > rays / 2u);
+    if (scene->inst_count > 0) assert_true(insts > 0);
+}
+#endif
+
 /* A scene of the sphere and, with boxes 1, a box (geometry 1) and the same
  * box again (geometry 2), all referenced; with boxes 2 also two instances of
  * a scene of the box, one where the own box is (hits there tie between
@@ -124,6 +169,9 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
         assert_true(ondn_beams->origin_spread2 > 0.0f &&
                     ondn_beams->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);
         check_sensor(ctx, scene, o1dn, rays);
+#if defined(RC__HIT_DISTANCES_SSE2)
+        check_distances(scene, o1dn, rays);
+#endif
         check_sensor(ctx, scene, ondn, rays);
         check_sensor(ctx, scene, ondn_beams, rays);
         rc_sensor_destroy(o1dn);

@@ -200,6 +200,12 @@ static void trace_tiles(const sim_run *run, const uint32_t *recs, uint32_t first
         trace_group(run, job->scene, group, rays, n, hits, found);
         for (k = 0; k < group; ++k) {
             uint64_t base = (uint64_t)(pose0 + pose[k]) * sensor->rays;
+#if defined(RC__HIT_DISTANCES_SSE2)
+            if (!sensor->origins) {
+                rc__write_results_tile(job, base, idx[k], n[k], found[k], hits[k], &worlds[pose[k]]);
+                continue;
+            }
+#endif
             for (i = 0; i < n[k]; ++i) {
                 const float *os = sensor->origins ? sensor->origins + (size_t)idx[k][i] * 3u : NULL;
                 rc__write_result(job, base + idx[k][i], sensor->directions + (size_t)idx[k][i] * 3u, os, found[k][i],

@@ -4,7 +4,11 @@
  * this object rather than its own, which measured 1.7 KB more in the static
  * library, issue 6's size budget). */
 #include "backend/backend.h"
+#include "bvh/intersect.h" /* RC__FORCE_INLINE */
 #include "core/work_order.h"
+#if defined(RC__HIT_DISTANCES_SSE2)
+#include "bvh/packet.h" /* RC__PACKET_SIZE */
+#endif
 
 #include <math.h>
 #include <string.h>
@@ -32,8 +36,12 @@ void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out)
     rc__xform_to_float(&world, out);
 }
 
-void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s, int found,
-                      const rc__hit *hit, const float n_world_in[3], const rc__xformf *world)
+/* rc__write_result given the hit's distance refined in float64
+ * (rc__scene_hit_distance_d: it removes the float rounding of the
+ * traversal's t) */
+static RC__FORCE_INLINE void write_refined(const rc__sim_job *job, uint64_t k, const float dir_s[3],
+                                           const float *org_s, int found, const rc__hit *hit, double td,
+                                           const float n_world_in[3], const rc__xformf *world)
 {
     const rc_results *out = job->out;
     const uint32_t attr = job->attributes;
@@ -42,15 +50,10 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
     int valid;
     float range;
 
-    if (found) {
-        /* float64 refinement of the distance along the ray (cheap: once per
-         * hit): removes the float rounding of the traversal's t */
-        const double td = rc__scene_hit_distance_d(job->scene, hit, world, dir_s, org_s);
-        /* the plane of the hit triangle in double is the better distance, also
-         * for needles and slivers where the float test's t is coarse; a
-         * non-positive value (origin on the plane) keeps the traversal's t */
-        if (td > 0.0 && td < 3.0e38 && (float)td > 0.0f) t = (float)td;
-    }
+    /* the plane of the hit triangle in double is the better distance, also
+     * for needles and slivers where the float test's t is coarse; a
+     * non-positive value (origin on the plane) keeps the traversal's t */
+    if (found && td > 0.0 && td < 3.0e38 && (float)td > 0.0f) t = (float)td;
     valid = found && t >= sensor->range_min && t <= sensor->range_max;
 
     if (valid)
@@ -104,6 +107,27 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
     if (attr & RC_ATTR_GEOM_IDS) out->geom_ids[k] = valid ? hit->geom : RC_INVALID_ID;
     if (attr & RC_ATTR_INST_IDS) out->inst_ids[k] = valid ? hit->inst : RC_INVALID_ID;
 }
+
+void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s, int found,
+                      const rc__hit *hit, const float n_world_in[3], const rc__xformf *world)
+{
+    write_refined(job, k, dir_s, org_s, found, hit,
+                  found ? rc__scene_hit_distance_d(job->scene, hit, world, dir_s, org_s) : 0.0, n_world_in, world);
+}
+
+#if defined(RC__HIT_DISTANCES_SSE2)
+void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t n, const int *found,
+                            const rc__hit *hits, const rc__xformf *world)
+{
+    const float *directions = job->sensor->directions;
+    double td[RC__PACKET_SIZE];
+    uint32_t i;
+    rc__scene_hit_distances_d(job->scene, hits, found, n, world, directions, idx, td);
+    for (i = 0; i < n; ++i)
+        write_refined(job, base + idx[i], directions + (size_t)idx[i] * 3u, NULL, found[i], &hits[i], td[i], NULL,
+                      world);
+}
+#endif
 
 /* Ordered runs (core/work_order.h). */
 

@@ -114,6 +114,18 @@ static inline int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray,
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
                                 const float dir_s[3], const float *org_s);
 
+#if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
+#include <emmintrin.h>
+/* rc__scene_hit_distance_d for the n rays of a tile of a one-origin sensor
+ * (ray i: sensor direction directions[3 * idx[i]], hit hits[i] where
+ * found[i]), two hits at a time in SSE2 doubles, each value bit for bit the
+ * scalar function's; td[i] = 0 where found[i] is 0. (1k sphere: the
+ * refinement one hit at a time was 14% of the instructions.) */
+#define RC__HIT_DISTANCES_SSE2 1
+void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const int *found, uint32_t n,
+                               const rc__xformf *world, const float *directions, const uint32_t *idx, double *td);
+#endif
+
 /* Unit geometric normal of a hit, in the scene's frame. */
 void rc__scene_hit_normal(const rc_scene *scene, const rc__hit *hit, float n[3]);
 

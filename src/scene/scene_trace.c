@@ -181,3 +181,69 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
     if (dn == 0.0 || !isfinite(w / dn)) return hit->t;
     return w / dn;
 }
+
+#if defined(RC__HIT_DISTANCES_SSE2)
+/* Two hits' vertices, converted to double, one hit a lane */
+#define PAIR_PD(p, q, k) _mm_setr_pd((double)(p)[k], (double)(q)[k])
+
+/* rc__scene_hit_distance_d of hits i and j (own meshes, shared origin) in
+ * the two lanes of SSE2 doubles: the same operations in the same order, so
+ * each lane is the scalar function's value bit for bit. */
+static void hit_distance_pair(const rc_scene *scene, const rc__hit *hi, const rc__hit *hj, const rc__xformf *world,
+                              const float *di, const float *dj, double *ti, double *tj)
+{
+    const rc__mesh *mi = &scene->geoms[hi->geom].mesh, *mj = &scene->geoms[hj->geom].mesh;
+    const uint32_t *tri_i = hit_triangle(mi, hi), *tri_j = hit_triangle(mj, hj);
+    const float *a0 = mi->vertices + (size_t)tri_i[0] * mi->stride, *a1 = mj->vertices + (size_t)tri_j[0] * mj->stride;
+    const float *b0 = mi->vertices + (size_t)tri_i[1] * mi->stride, *b1 = mj->vertices + (size_t)tri_j[1] * mj->stride;
+    const float *c0 = mi->vertices + (size_t)tri_i[2] * mi->stride, *c1 = mj->vertices + (size_t)tri_j[2] * mj->stride;
+    const double *r = world->rd;
+    const __m128d px = PAIR_PD(di, dj, 0), py = PAIR_PD(di, dj, 1), pz = PAIR_PD(di, dj, 2);
+    const __m128d dx = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[0]), px), _mm_mul_pd(_mm_set1_pd(r[1]), py)),
+                                  _mm_mul_pd(_mm_set1_pd(r[2]), pz));
+    const __m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[3]), px), _mm_mul_pd(_mm_set1_pd(r[4]), py)),
+                                  _mm_mul_pd(_mm_set1_pd(r[5]), pz));
+    const __m128d dz = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[6]), px), _mm_mul_pd(_mm_set1_pd(r[7]), py)),
+                                  _mm_mul_pd(_mm_set1_pd(r[8]), pz));
+    const __m128d ax = PAIR_PD(a0, a1, 0), ay = PAIR_PD(a0, a1, 1), az = PAIR_PD(a0, a1, 2);
+    const __m128d e1x = _mm_sub_pd(PAIR_PD(b0, b1, 0), ax), e1y = _mm_sub_pd(PAIR_PD(b0, b1, 1), ay);
+    const __m128d e1z = _mm_sub_pd(PAIR_PD(b0, b1, 2), az), e2x = _mm_sub_pd(PAIR_PD(c0, c1, 0), ax);
+    const __m128d e2y = _mm_sub_pd(PAIR_PD(c0, c1, 1), ay), e2z = _mm_sub_pd(PAIR_PD(c0, c1, 2), az);
+    const __m128d nx = _mm_sub_pd(_mm_mul_pd(e1y, e2z), _mm_mul_pd(e1z, e2y));
+    const __m128d ny = _mm_sub_pd(_mm_mul_pd(e1z, e2x), _mm_mul_pd(e1x, e2z));
+    const __m128d nz = _mm_sub_pd(_mm_mul_pd(e1x, e2y), _mm_mul_pd(e1y, e2x));
+    const __m128d dn = _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, dx), _mm_mul_pd(ny, dy)), _mm_mul_pd(nz, dz));
+    const __m128d w =
+        _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, _mm_sub_pd(ax, _mm_set1_pd(world->td[0]))),
+                              _mm_mul_pd(ny, _mm_sub_pd(ay, _mm_set1_pd(world->td[1])))),
+                   _mm_mul_pd(nz, _mm_sub_pd(az, _mm_set1_pd(world->td[2]))));
+    double q[2], d[2];
+    _mm_storeu_pd(q, _mm_div_pd(w, dn));
+    _mm_storeu_pd(d, dn);
+    *ti = d[0] == 0.0 || !isfinite(q[0]) ? (double)hi->t : q[0];
+    *tj = d[1] == 0.0 || !isfinite(q[1]) ? (double)hj->t : q[1];
+}
+#undef PAIR_PD
+
+void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const int *found, uint32_t n,
+                               const rc__xformf *world, const float *directions, const uint32_t *idx, double *td)
+{
+    uint32_t i, held = UINT32_MAX; /* a hit waiting for a second lane */
+    for (i = 0; i < n; ++i) {
+        const float *dir = directions + (size_t)idx[i] * 3u;
+        if (!found[i]) {
+            td[i] = 0.0;
+        } else if (hits[i].inst != RC_INVALID_ID) {
+            td[i] = rc__scene_hit_distance_d(scene, &hits[i], world, dir, NULL);
+        } else if (held == UINT32_MAX) {
+            held = i;
+        } else {
+            hit_distance_pair(scene, &hits[held], &hits[i], world, directions + (size_t)idx[held] * 3u, dir, &td[held],
+                              &td[i]);
+            held = UINT32_MAX;
+        }
+    }
+    if (held != UINT32_MAX)
+        td[held] = rc__scene_hit_distance_d(scene, &hits[held], world, directions + (size_t)idx[held] * 3u, NULL);
+}
+#endif
