@@ -7,7 +7,8 @@
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
  * instance. On x86 also the packets' refinement of a tile's hits two at a
- * time, against the one-hit function. (test_packet.c and test_wide.c check the traversals bit for bit;
+ * time, against the one-hit function (the Embree backend's batches use it
+ * too, with hits that carry no leaf slot). (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
  * context's threshold is set by the test, whatever this CPU's cache. */
 #include <math.h>
@@ -111,6 +112,8 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
             hits[i].t = RANGE_MAX;
             hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
             found[i] = (at + i) % 7u != 3u && rc__scene_intersect(scene, &r, &hits[i]);
+            /* as Embree's hits come: no leaf slot, the mesh's own triples */
+            if ((at + i) % 3u == 1u) hits[i].slot = RC_INVALID_ID;
             insts += found[i] && hits[i].inst != RC_INVALID_ID;
         }
         rc__scene_hit_distances_d(scene, hits, found, n, &world, s->directions, idx, td);

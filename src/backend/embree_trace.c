@@ -185,8 +185,23 @@ static RC__PREFETCH_INLINE void batch_prefetch(const trace_run *run, const hit_b
 static void batch_write(const trace_run *run, const rc__xformf *worlds, uint32_t pose0, hit_batch *b)
 {
     const rc__sim_job *job = run->job;
-    uint32_t i;
-    for (i = 0; i < b->count; ++i) {
+    uint32_t i = 0;
+#if defined(RC__HIT_DISTANCES_SSE2)
+    /* one-origin sensors: up to a packet's worth of entries of one pose at a
+     * time, their hits refined two at a time */
+    while (!run->origins && i < b->count) {
+        int found[RC__PACKET_SIZE];
+        uint32_t n = 0;
+        while (n < RC__PACKET_SIZE && i + n < b->count && b->pose[i + n] == b->pose[i]) {
+            found[n] = b->found[i + n];
+            ++n;
+        }
+        rc__write_results_tile(job, (uint64_t)(pose0 + b->pose[i]) * job->sensor->rays, &b->ray[i], n, found,
+                               &b->hit[i], &worlds[b->pose[i]]);
+        i += n;
+    }
+#endif
+    for (; i < b->count; ++i) {
         uint32_t r = b->ray[i];
         const float *ds = run->directions + (size_t)r * 3u;
         const float *os = run->origins ? run->origins + (size_t)r * 3u : NULL;
