@@ -99,7 +99,7 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
     int found[RC__PACKET_SIZE];
     uint32_t idx[RC__PACKET_SIZE];
     double td[RC__PACKET_SIZE];
-    uint32_t at = 0, n = 1, i, pairs = 0, insts = 0;
+    uint32_t at = 0, n = 1, i, refined = 0, insts = 0;
     rc__sensor_world_xform(s, &pose, &world);
     while (at + n <= rays) {
         for (i = 0; i < n; ++i) {
@@ -121,12 +121,12 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
             const double want =
                 found[i] ? rc__scene_hit_distance_d(scene, &hits[i], &world, s->directions + 3u * idx[i], NULL) : 0.0;
             assert_memory_equal(&td[i], &want, sizeof want);
-            pairs += found[i];
+            refined += found[i];
         }
         at += n;
         n = n % RC__PACKET_SIZE + 1u;
     }
-    assert_true(pairs > rays / 2u);
+    assert_true(refined > rays / 2u);
     if (scene->inst_count > 0) assert_true(insts > 0);
 }
 #endif

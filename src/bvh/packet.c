@@ -659,6 +659,9 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         uint32_t m = mask, known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
         int shrunk = 0;
 #if defined(RC__LEAF4_SSE2)
+        /* one live lane (most leaf visits on a large map): its rows gathered
+         * in registers, without the copy (1M +2.6%); the loop below then has
+         * nothing left */
         if (!(m & (m - 1u))) {
             const uint32_t lane = lowest_lane(m);
             rc__leaf4_test(&rays[lane], (const float *const(*)[3])vt, n_tri, &lo);
