@@ -149,8 +149,7 @@ static void test_order_key(void **state)
 #if defined(RANGECAST_WITH_EMBREE)
 static int occupied(const rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z)
 {
-    const uint32_t i = (z * RC__OCC_N + y) * RC__OCC_N + x;
-    return (g->bits[i >> 3] >> (i & 7u)) & 1u;
+    return g->dist[(z * RC__OCC_N + y) * RC__OCC_N + x] == 0;
 }
 
 /* The cell of point p, or -1 outside the grid. */
@@ -185,6 +184,27 @@ static void test_occupancy_key(void **state)
     /* the centre of the sphere is empty, its shell is not */
     assert_false(occupied(g, RC__OCC_N / 2u, RC__OCC_N / 2u, RC__OCC_N / 2u));
     assert_true(occupied(g, 0u, RC__OCC_N / 2u, RC__OCC_N / 2u));
+    /* each cell's distance is its chessboard distance to the nearest
+     * occupied cell, found here by looking at every cell */
+    for (i = 0; i < 40u; ++i) {
+        const uint32_t x = i == 0 ? RC__OCC_N / 2u : (uint32_t)(rcu_rng_uniform(&rng) * RC__OCC_N),
+                       y = i == 0 ? RC__OCC_N / 2u : (uint32_t)(rcu_rng_uniform(&rng) * RC__OCC_N),
+                       z = i == 0 ? RC__OCC_N / 2u : (uint32_t)(rcu_rng_uniform(&rng) * RC__OCC_N);
+        uint32_t best = RC__OCC_FAR, qx, qy, qz;
+        for (qz = 0; qz < RC__OCC_N; ++qz)
+            for (qy = 0; qy < RC__OCC_N; ++qy)
+                for (qx = 0; qx < RC__OCC_N; ++qx) {
+                    const uint32_t dx = qx > x ? qx - x : x - qx, dy = qy > y ? qy - y : y - qy,
+                                   dz = qz > z ? qz - z : z - qz;
+                    uint32_t d = dx > dy ? dx : dy;
+                    d = dz > d ? dz : d;
+                    if (d < best && occupied(g, qx, qy, qz)) best = d;
+                }
+        assert_int_equal(g->dist[(z * RC__OCC_N + y) * RC__OCC_N + x], best);
+        /* the walk leaps from the centre: the sphere is 32 cells away, and its
+         * nearest cell by the chessboard metric lies on a diagonal, 32 / sqrt(3) */
+        if (i == 0) assert_true(best >= 16u);
+    }
     for (i = 0; i < 500u; ++i) {
         float org[3], dir[3];
         uint32_t key, c[3] = {0, 0, 0}, b, k;

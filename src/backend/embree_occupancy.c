@@ -14,22 +14,42 @@ static int cell_of(const rc__occupancy *g, int axis, float v)
     return c >= (float)(N - 1u) ? (int)(N - 1u) : (int)c;
 }
 
-static void set_bit(rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z)
-{
-    const uint32_t i = (z * N + y) * N + x;
-    g->bits[i >> 3] = (uint8_t)(g->bits[i >> 3] | (1u << (i & 7u)));
-}
+static uint32_t cell_index(uint32_t x, uint32_t y, uint32_t z) { return (z * N + y) * N + x; }
 
-static int get_bit(const rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z)
+/* One pass of the chessboard distance transform: each cell takes one more
+ * than the least of its already visited neighbours (the 13 that come before
+ * it in the pass's order). A forward and a backward pass give the exact
+ * distance (unit weights on the 3x3x3 neighbourhood). */
+static void distance_pass(uint8_t *dist, int backward)
 {
-    const uint32_t i = (z * N + y) * N + x;
-    return (g->bits[i >> 3] >> (i & 7u)) & 1u;
+    const int first = backward ? (int)N - 1 : 0, last = backward ? -1 : (int)N, dir = backward ? -1 : 1;
+    int x, y, z, dx, dy, dz;
+    for (z = first; z != last; z += dir)
+        for (y = first; y != last; y += dir)
+            for (x = first; x != last; x += dir) {
+                uint8_t *c = &dist[cell_index((uint32_t)x, (uint32_t)y, (uint32_t)z)];
+                uint32_t best = *c;
+                if (best == 0) continue;
+                for (dz = -1; dz <= 0; ++dz)
+                    for (dy = -1; dy <= 1; ++dy)
+                        for (dx = -1; dx <= 1; ++dx) {
+                            /* the neighbours before this cell in the pass's order */
+                            const int nx = x + dir * dx, ny = y + dir * dy, nz = z + dir * dz;
+                            if (dz == 0 && (dy > 0 || (dy == 0 && dx >= 0))) continue;
+                            if (nx < 0 || ny < 0 || nz < 0 || nx >= (int)N || ny >= (int)N || nz >= (int)N) continue;
+                            {
+                                const uint32_t d = dist[cell_index((uint32_t)nx, (uint32_t)ny, (uint32_t)nz)] + 1u;
+                                best = d < best ? d : best;
+                            }
+                        }
+                *c = (uint8_t)best;
+            }
 }
 
 void rc__occupancy_build(rc__occupancy *g, const rc_scene *scene)
 {
     uint32_t k, geom, t;
-    memset(g->bits, 0, sizeof g->bits);
+    memset(g->dist, (int)RC__OCC_FAR, sizeof g->dist);
     g->triangles = scene->triangle_count;
     memcpy(g->bounds, &scene->bounds, sizeof g->bounds);
     for (k = 0; k < 3; ++k) {
@@ -55,9 +75,11 @@ void rc__occupancy_build(rc__occupancy *g, const rc_scene *scene)
             }
             for (z = lo[2]; z <= hi[2]; ++z)
                 for (y = lo[1]; y <= hi[1]; ++y)
-                    for (x = lo[0]; x <= hi[0]; ++x) set_bit(g, x, y, z);
+                    for (x = lo[0]; x <= hi[0]; ++x) g->dist[cell_index(x, y, z)] = 0;
         }
     }
+    distance_pass(g->dist, 0);
+    distance_pass(g->dist, 1);
 }
 
 /* Spreads the low 6 bits of v to every third bit. */
@@ -66,6 +88,24 @@ static uint32_t spread3(uint32_t v)
     uint32_t r = 0, b;
     for (b = 0; b < 6u; ++b) r |= ((v >> b) & 1u) << (3u * b);
     return r;
+}
+
+/* Puts the walk at t along the ray: the cell there, and the distances to
+ * that cell's exit face on each axis. */
+static void enter_cell(const rc__occupancy *g, const float org[3], const float dir[3], float t, int cell[3],
+                       float next[3])
+{
+    int k;
+    for (k = 0; k < 3; ++k) {
+        const float p = org[k] + dir[k] * t;
+        cell[k] = cell_of(g, k, p);
+        if (dir[k] == 0.0f || !(g->scale[k] > 0.0f)) {
+            next[k] = INFINITY;
+        } else {
+            const float face = g->min[k] + (float)(cell[k] + (dir[k] > 0.0f ? 1 : 0)) / g->scale[k];
+            next[k] = (face - org[k]) / dir[k];
+        }
+    }
 }
 
 uint32_t rc__occupancy_key(const rc__occupancy *g, const float org[3], const float dir[3], float tmax)
@@ -90,22 +130,32 @@ uint32_t rc__occupancy_key(const rc__occupancy *g, const float org[3], const flo
     }
     if (!(t0 <= t1)) return UINT32_MAX; /* misses the grid, or NaN */
     for (k = 0; k < 3; ++k) {
-        const float p = org[k] + dir[k] * t0, size = g->scale[k] > 0.0f ? 1.0f / g->scale[k] : 0.0f;
-        cell[k] = cell_of(g, k, p);
         step[k] = dir[k] > 0.0f ? 1 : -1;
-        if (dir[k] == 0.0f || size == 0.0f) {
-            next[k] = delta[k] = INFINITY;
-        } else {
-            /* distance to the cell's exit face along the ray */
-            const float face = g->min[k] + (float)(cell[k] + (dir[k] > 0.0f ? 1 : 0)) * size;
-            next[k] = (face - org[k]) / dir[k];
-            delta[k] = size / fabsf(dir[k]);
-        }
+        delta[k] = dir[k] == 0.0f || !(g->scale[k] > 0.0f) ? INFINITY : 1.0f / (g->scale[k] * fabsf(dir[k]));
     }
-    /* a ray crosses at most 3N cells; the bound also ends a NaN walk */
+    enter_cell(g, org, dir, t0, cell, next);
+    /* a ray crosses at most 3N cells, and a leap passes one at least; the
+     * bound also ends a NaN walk */
     for (steps = 0; steps < 3 * (int)N; ++steps) {
-        if (get_bit(g, (uint32_t)cell[0], (uint32_t)cell[1], (uint32_t)cell[2]))
+        const uint32_t d = g->dist[cell_index((uint32_t)cell[0], (uint32_t)cell[1], (uint32_t)cell[2])];
+        if (d == 0)
             return spread3((uint32_t)cell[0]) | spread3((uint32_t)cell[1]) << 1 | spread3((uint32_t)cell[2]) << 2;
+        if (d >= 2u) {
+            /* every cell within d - 1 of this one is empty: go to where the
+             * ray leaves that cube (at least a cell on) */
+            float leave = INFINITY;
+            for (k = 0; k < 3; ++k) {
+                if (next[k] == INFINITY) continue;
+                {
+                    const int face = dir[k] > 0.0f ? cell[k] + (int)d : cell[k] - (int)d + 1;
+                    const float tk = (g->min[k] + (float)face / g->scale[k] - org[k]) / dir[k];
+                    leave = tk < leave ? tk : leave;
+                }
+            }
+            if (!(leave <= t1)) return UINT32_MAX;
+            enter_cell(g, org, dir, leave, cell, next);
+            continue;
+        }
         k = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
         if (!(next[k] <= t1)) return UINT32_MAX;
         cell[k] += step[k];
