@@ -1,5 +1,6 @@
 #include "backend/embree_occupancy.h"
 
+#include "bvh/intersect.h"
 #include "scene/scene.h"
 
 #include <math.h>
@@ -90,32 +91,41 @@ static uint32_t spread3(uint32_t v)
     return r;
 }
 
-/* Puts the walk at t along the ray: the cell there, and the distances to
- * that cell's exit face on each axis. */
-static void enter_cell(const rc__occupancy *g, const float org[3], const float dir[3], float t, int cell[3],
-                       float next[3])
+/* A ray's walk through the grid: per axis its origin, the reciprocal of its
+ * direction (0 along an axis it does not move on, or where the grid is flat)
+ * and the cell's size, so that each step multiplies instead of divides. */
+typedef struct occ_walk {
+    float org[3], inv[3], size[3];
+    int cell[3];
+    float next[3]; /* t where the ray leaves the cell on each axis (INFINITY: never) */
+} occ_walk;
+
+/* Puts the walk at t along the ray (dir): the cell there, and where the ray
+ * leaves that cell on each axis. */
+static RC__FORCE_INLINE void enter_cell(const rc__occupancy *g, occ_walk *w, const float dir[3], float t)
 {
     int k;
     for (k = 0; k < 3; ++k) {
-        const float p = org[k] + dir[k] * t;
-        cell[k] = cell_of(g, k, p);
-        if (dir[k] == 0.0f || !(g->scale[k] > 0.0f)) {
-            next[k] = INFINITY;
-        } else {
-            const float face = g->min[k] + (float)(cell[k] + (dir[k] > 0.0f ? 1 : 0)) / g->scale[k];
-            next[k] = (face - org[k]) / dir[k];
-        }
+        w->cell[k] = cell_of(g, k, w->org[k] + dir[k] * t);
+        w->next[k] = w->inv[k] == 0.0f ? INFINITY
+                                       : (g->min[k] + (float)(w->cell[k] + (w->inv[k] > 0.0f)) * w->size[k] - w->org[k]) *
+                                             w->inv[k];
     }
 }
 
 uint32_t rc__occupancy_key(const rc__occupancy *g, const float org[3], const float dir[3], float tmax)
 {
-    float t0 = 0.0f, t1 = tmax, next[3], delta[3];
-    int cell[3], step[3], k, steps;
+    float t0 = 0.0f, t1 = tmax, delta[3];
+    occ_walk w;
+    int k, steps;
     for (k = 0; k < 3; ++k)
         if (!isfinite(org[k]) || !isfinite(dir[k])) return UINT32_MAX;
     for (k = 0; k < 3; ++k) {
         const float lo = g->min[k], hi = g->scale[k] > 0.0f ? g->min[k] + (float)N / g->scale[k] : g->min[k];
+        w.org[k] = org[k];
+        w.size[k] = g->scale[k] > 0.0f ? 1.0f / g->scale[k] : 0.0f;
+        w.inv[k] = dir[k] != 0.0f && g->scale[k] > 0.0f ? 1.0f / dir[k] : 0.0f;
+        delta[k] = w.size[k] * fabsf(w.inv[k]);
         if (dir[k] != 0.0f) {
             float a = (lo - org[k]) / dir[k], b = (hi - org[k]) / dir[k];
             if (a > b) {
@@ -129,38 +139,33 @@ uint32_t rc__occupancy_key(const rc__occupancy *g, const float org[3], const flo
         }
     }
     if (!(t0 <= t1)) return UINT32_MAX; /* misses the grid, or NaN */
-    for (k = 0; k < 3; ++k) {
-        step[k] = dir[k] > 0.0f ? 1 : -1;
-        delta[k] = dir[k] == 0.0f || !(g->scale[k] > 0.0f) ? INFINITY : 1.0f / (g->scale[k] * fabsf(dir[k]));
-    }
-    enter_cell(g, org, dir, t0, cell, next);
+    enter_cell(g, &w, dir, t0);
     /* a ray crosses at most 3N cells, and a leap passes one at least; the
      * bound also ends a NaN walk */
     for (steps = 0; steps < 3 * (int)N; ++steps) {
-        const uint32_t d = g->dist[cell_index((uint32_t)cell[0], (uint32_t)cell[1], (uint32_t)cell[2])];
-        if (d == 0)
-            return spread3((uint32_t)cell[0]) | spread3((uint32_t)cell[1]) << 1 | spread3((uint32_t)cell[2]) << 2;
+        const int *c = w.cell;
+        const uint32_t d = g->dist[cell_index((uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2])];
+        if (d == 0) return spread3((uint32_t)c[0]) | spread3((uint32_t)c[1]) << 1 | spread3((uint32_t)c[2]) << 2;
         if (d >= 2u) {
             /* every cell within d - 1 of this one is empty: go to where the
              * ray leaves that cube (at least a cell on) */
             float leave = INFINITY;
             for (k = 0; k < 3; ++k) {
-                if (next[k] == INFINITY) continue;
-                {
-                    const int face = dir[k] > 0.0f ? cell[k] + (int)d : cell[k] - (int)d + 1;
-                    const float tk = (g->min[k] + (float)face / g->scale[k] - org[k]) / dir[k];
+                if (w.inv[k] != 0.0f) {
+                    const int face = w.inv[k] > 0.0f ? c[k] + (int)d : c[k] - (int)d + 1;
+                    const float tk = (g->min[k] + (float)face * w.size[k] - w.org[k]) * w.inv[k];
                     leave = tk < leave ? tk : leave;
                 }
             }
             if (!(leave <= t1)) return UINT32_MAX;
-            enter_cell(g, org, dir, leave, cell, next);
+            enter_cell(g, &w, dir, leave);
             continue;
         }
-        k = next[0] < next[1] ? (next[0] < next[2] ? 0 : 2) : (next[1] < next[2] ? 1 : 2);
-        if (!(next[k] <= t1)) return UINT32_MAX;
-        cell[k] += step[k];
-        if (cell[k] < 0 || cell[k] >= (int)N) return UINT32_MAX;
-        next[k] += delta[k];
+        k = w.next[0] < w.next[1] ? (w.next[0] < w.next[2] ? 0 : 2) : (w.next[1] < w.next[2] ? 1 : 2);
+        if (!(w.next[k] <= t1)) return UINT32_MAX;
+        w.cell[k] += w.inv[k] > 0.0f ? 1 : -1;
+        if (w.cell[k] < 0 || w.cell[k] >= (int)N) return UINT32_MAX;
+        w.next[k] += delta[k];
     }
     return UINT32_MAX;
 }
