@@ -260,6 +260,44 @@ static void test_occupancy_key(void **state)
     rcu_mesh_free(&sphere);
 }
 
+/* A flat map (one axis of the grid has no extent) and directions that are
+ * zero, denormal or along an axis: the walk ends, and any key it gives names
+ * an occupied cell. From above, a ray straight down meets the plane's cells. */
+static void test_occupancy_key_flat(void **state)
+{
+    rcu_mesh plane;
+    const float centre[3] = {0.0f, 0.0f, 0.0f};
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 16);
+    rc_scene *scene;
+    rc__occupancy *g = malloc(sizeof *g);
+    const float tiny = 1e-40f; /* denormal: its reciprocal overflows */
+    const float dirs[][3] = {{0.0f, 0.0f, -1.0f}, {1.0f, 0.0f, 0.0f},  {0.0f, 0.0f, 0.0f},  {tiny, 0.0f, -1.0f},
+                             {tiny, tiny, -tiny}, {1.0f, 1.0f, -1.0f}, {-1.0f, tiny, 0.0f}, {0.3f, -0.2f, -tiny}};
+    const float orgs[][3] = {{0.0f, 0.0f, 5.0f}, {-20.0f, 0.0f, 0.0f}, {3.0f, -2.0f, 0.0f}, {0.5f, 0.5f, 1.0f}};
+    uint32_t i, j, k, b;
+    (void)state;
+    assert_non_null(g);
+    assert_int_equal(rcu_mesh_plane(centre, 10.0f, &plane), 0);
+    scene = rct_scene_mesh(ctx, &plane, RC_MESH_REFERENCE);
+    rc__occupancy_build(g, scene);
+    assert_true(g->scale[2] == 0.0f);
+    for (i = 0; i < sizeof orgs / sizeof orgs[0]; ++i)
+        for (j = 0; j < sizeof dirs / sizeof dirs[0]; ++j) {
+            const uint32_t key = rc__occupancy_key(g, orgs[i], dirs[j], 1e6f);
+            uint32_t c[3] = {0, 0, 0};
+            if (key == UINT32_MAX) continue;
+            for (b = 0; b < 6u; ++b)
+                for (k = 0; k < 3; ++k) c[k] |= ((key >> (3u * b + k)) & 1u) << b;
+            assert_true(occupied(g, c[0], c[1], c[2]));
+        }
+    assert_int_not_equal(rc__occupancy_key(g, orgs[0], dirs[0], 1e6f), UINT32_MAX);
+    assert_int_not_equal(rc__occupancy_key(g, orgs[0], dirs[3], 1e6f), UINT32_MAX);
+    free(g);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&plane);
+}
+
 #endif
 
 /* A scene of the sphere and, with box set, a box inside it (geometry 0, so
@@ -453,6 +491,7 @@ int main(void)
         cmocka_unit_test(test_order_key),
 #if defined(RANGECAST_WITH_EMBREE)
         cmocka_unit_test(test_occupancy_key),
+        cmocka_unit_test(test_occupancy_key_flat),
 #endif
         cmocka_unit_test(test_ordered_matches_scan_order),
         cmocka_unit_test(test_ordered_without_room),
