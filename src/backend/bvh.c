@@ -41,7 +41,8 @@ typedef struct sim_run {
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
     int own_origins;                 /* 1 when each ray has its own origin (OnDn) */
-    uint32_t in_flight;              /* tiles traced at once: RC__PACKETS_IN_FLIGHT with a large mesh, else 1 */
+    uint32_t in_flight;              /* tiles traced at once: RC__PACKETS_IN_FLIGHT with a large mesh (1 when
+                                      * ordered in a map the cache nearly holds), else 1 */
     int rays_by_mesh;                /* 1 when single rays go mesh by mesh, taking turns in large ones */
     uint32_t chunk_poses;            /* ordered runs: poses a task */
     uint32_t order_depth;            /* ordered runs: depth of the key (rc__mesh_order_key) */
@@ -294,6 +295,9 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     }
     /* larger than the cache, and large enough that packets take turns */
     if (biggest <= ctx->ordered_mesh_bytes || biggest <= ctx->large_mesh_bytes) return 0;
+    /* ordered packets in a map the cache nearly holds: one tile at a time
+     * (ctx->ordered_turns_bytes) */
+    if (run->packets && biggest <= ctx->ordered_turns_bytes) run->in_flight = 1;
     chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles);
     if (chunk == 0) return 0;
     run->chunk_poses = chunk;
@@ -369,6 +373,7 @@ static rc_status bvh_init(rc_context *ctx, const rc_context_desc *desc)
     const uint64_t llc = rc__last_level_cache_bytes();
     ctx->large_mesh_bytes = rc__large_mesh_threshold(llc);
     ctx->ordered_mesh_bytes = rc__ordered_mesh_threshold(llc);
+    ctx->ordered_turns_bytes = llc * 2u; /* 0 when unknown; it picks only how packets go */
     return RC_OK;
 }
 static void bvh_deinit(rc_context *ctx) { (void)ctx; }

@@ -35,6 +35,14 @@ struct rc_context {
     /* The built-in backend orders a call's tiles on meshes larger than this
      * (rc__ordered_mesh_threshold; UINT64_MAX: never). */
     uint64_t ordered_mesh_bytes;
+    /* Ordered, the built-in backend's packets take turns only in meshes
+     * larger than this: twice the last-level cache (0 when its size is
+     * unknown: always). Ordered, a map the cache nearly holds is met mostly
+     * in cache, and the turns' bookkeeping costs more than it hides: on an
+     * AMD VM with a 32 MiB L3 (docs/benchmarks.md, session 27), VLP-16,
+     * 2 threads, one tile at a time against turns measured 1M triangles
+     * (30 MiB) +19%, 2M +5%, 4M +3.5%, 10M -3%. */
+    uint64_t ordered_turns_bytes;
     rc_log_fn log;
     void *log_user;
     struct rc_scene *scenes;        /* singly linked, newest first */
