@@ -295,9 +295,6 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     }
     /* larger than the cache, and large enough that packets take turns */
     if (biggest <= ctx->ordered_mesh_bytes || biggest <= ctx->large_mesh_bytes) return 0;
-    /* ordered packets in a map the cache nearly holds: one tile at a time
-     * (ctx->ordered_turns_bytes) */
-    if (run->packets && biggest <= ctx->ordered_turns_bytes) run->in_flight = 1;
     chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles);
     if (chunk == 0) return 0;
     run->chunk_poses = chunk;
@@ -309,7 +306,11 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
         ++run->order_depth;
     run->order_scratch_stride = rc__order_scratch_bytes(chunk, run->tiles, sizeof(rc__xformf));
     run->order_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->order_scratch_stride * threads);
-    return run->order_scratch != NULL;
+    if (!run->order_scratch) return 0;
+    /* ordered packets in a map the cache nearly holds: one tile at a time
+     * (ctx->ordered_turns_bytes) */
+    if (run->packets && biggest <= ctx->ordered_turns_bytes) run->in_flight = 1;
+    return 1;
 }
 
 static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)

@@ -134,7 +134,6 @@ uint64_t rc__large_mesh_threshold(uint64_t llc);
 #define RC__ORDERED_MESH_BYTES ((uint64_t)64u << 20)
 uint64_t rc__ordered_mesh_threshold(uint64_t llc);
 
-
 /* 1 when any hit with 0 < t < tmax exists (shadow/occlusion query). */
 int rc__mesh_occluded(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 
