@@ -147,9 +147,20 @@ static void test_order_key(void **state)
 }
 
 #if defined(RANGECAST_WITH_EMBREE)
-static int occupied(const rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z)
+static uint32_t cell_distance(const rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z)
 {
-    return g->dist[(z * RC__OCC_N + y) * RC__OCC_N + x] == 0;
+    return g->dist[(z * RC__OCC_N + y) * RC__OCC_N + x];
+}
+
+static int occupied(const rc__occupancy *g, uint32_t x, uint32_t y, uint32_t z) { return cell_distance(g, x, y, z) == 0; }
+
+/* The cell a key names (the Morton code's bits gathered back per axis). */
+static void key_cell(uint32_t key, uint32_t c[3])
+{
+    uint32_t b, k;
+    c[0] = c[1] = c[2] = 0;
+    for (b = 0; b < 6u; ++b)
+        for (k = 0; k < 3; ++k) c[k] |= ((key >> (3u * b + k)) & 1u) << b;
 }
 
 /* The cell of point p, or -1 outside the grid. */
@@ -200,14 +211,14 @@ static void test_occupancy_key(void **state)
                     d = dz > d ? dz : d;
                     if (d < best && occupied(g, qx, qy, qz)) best = d;
                 }
-        assert_int_equal(g->dist[(z * RC__OCC_N + y) * RC__OCC_N + x], best);
+        assert_int_equal(cell_distance(g, x, y, z), best);
         /* the walk leaps from the centre: the sphere is 32 cells away, and its
          * nearest cell by the chessboard metric lies on a diagonal, 32 / sqrt(3) */
         if (i == 0) assert_true(best >= 16u);
     }
     for (i = 0; i < 500u; ++i) {
         float org[3], dir[3];
-        uint32_t key, c[3] = {0, 0, 0}, b, k;
+        uint32_t key, c[3], k;
         double enter = 0.0, leave = 1e30, t;
         for (k = 0; k < 3; ++k) {
             org[k] = (float)((rcu_rng_uniform(&rng) - 0.5) * 20.0);
@@ -216,8 +227,7 @@ static void test_occupancy_key(void **state)
         key = rc__occupancy_key(g, org, dir, 1e6f);
         assert_int_not_equal(key, UINT32_MAX); /* from inside the closed sphere */
         assert_true(key < (1u << RC__OCC_KEY_BITS));
-        for (b = 0; b < 6u; ++b)
-            for (k = 0; k < 3; ++k) c[k] |= ((key >> (3u * b + k)) & 1u) << b;
+        key_cell(key, c);
         assert_true(occupied(g, c[0], c[1], c[2]));
         for (k = 0; k < 3; ++k) {
             const double lo = g->min[k] + c[k] / (double)g->scale[k], hi = g->min[k] + (c[k] + 1u) / (double)g->scale[k];
@@ -274,7 +284,7 @@ static void test_occupancy_key_flat(void **state)
     const float dirs[][3] = {{0.0f, 0.0f, -1.0f}, {1.0f, 0.0f, 0.0f},  {0.0f, 0.0f, 0.0f},  {tiny, 0.0f, -1.0f},
                              {tiny, tiny, -tiny}, {1.0f, 1.0f, -1.0f}, {-1.0f, tiny, 0.0f}, {0.3f, -0.2f, -tiny}};
     const float orgs[][3] = {{0.0f, 0.0f, 5.0f}, {-20.0f, 0.0f, 0.0f}, {3.0f, -2.0f, 0.0f}, {0.5f, 0.5f, 1.0f}};
-    uint32_t i, j, k, b;
+    uint32_t i, j;
     (void)state;
     assert_non_null(g);
     assert_int_equal(rcu_mesh_plane(centre, 10.0f, &plane), 0);
@@ -284,10 +294,9 @@ static void test_occupancy_key_flat(void **state)
     for (i = 0; i < sizeof orgs / sizeof orgs[0]; ++i)
         for (j = 0; j < sizeof dirs / sizeof dirs[0]; ++j) {
             const uint32_t key = rc__occupancy_key(g, orgs[i], dirs[j], 1e6f);
-            uint32_t c[3] = {0, 0, 0};
+            uint32_t c[3];
             if (key == UINT32_MAX) continue;
-            for (b = 0; b < 6u; ++b)
-                for (k = 0; k < 3; ++k) c[k] |= ((key >> (3u * b + k)) & 1u) << b;
+            key_cell(key, c);
             assert_true(occupied(g, c[0], c[1], c[2]));
         }
     assert_int_not_equal(rc__occupancy_key(g, orgs[0], dirs[0], 1e6f), UINT32_MAX);
