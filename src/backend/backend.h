@@ -70,7 +70,7 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
 /* rc__write_result for n rays of one pose of a one-origin sensor (a packet
  * tile, or a run of the Embree backend's batch; n <= RC__PACKET_SIZE; ray i
  * is element base + idx[i]; no normals passed in), their distances refined
- * two at a time (rc__scene_hit_distances_d) */
+ * two or four at a time (rc__scene_hit_distances_d) */
 void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t n, const int *found,
                             const rc__hit *hits, const rc__xformf *world);
 #endif

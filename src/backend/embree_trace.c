@@ -188,7 +188,7 @@ static void batch_write(const trace_run *run, const rc__xformf *worlds, uint32_t
     uint32_t i = 0;
 #if defined(RC__HIT_DISTANCES_SSE2)
     /* one-origin sensors: up to a packet's worth of entries of one pose at a
-     * time, their hits refined two at a time */
+     * time, their hits refined two or four at a time */
     while (!run->origins && i < b->count) {
         int found[RC__PACKET_SIZE];
         uint32_t n = 0;

@@ -118,9 +118,10 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
 #include <emmintrin.h>
 /* rc__scene_hit_distance_d for the n rays of a tile of a one-origin sensor
  * (ray i: sensor direction directions[3 * idx[i]], hit hits[i] where
- * found[i]), two hits at a time in SSE2 doubles, each value bit for bit the
- * scalar function's; td[i] = 0 where found[i] is 0. (1k sphere: the
- * refinement one hit at a time was 17% of the instructions.) */
+ * found[i]), two hits at a time in SSE2 doubles (four in AVX where the CPU
+ * has AVX2), each value bit for bit the scalar function's; td[i] = 0 where
+ * found[i] is 0. (1k sphere: the refinement one hit at a time was 17% of
+ * the instructions.) */
 #define RC__HIT_DISTANCES_SSE2 1
 void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const int *found, uint32_t n,
                                const rc__xformf *world, const float *directions, const uint32_t *idx, double *td);
