@@ -266,6 +266,20 @@ static RC__FORCE_INLINE uint32_t lowest_lane(uint32_t mask)
 #endif
 }
 
+/* 1 when mask has at most FEW_LANES lanes: one instruction where the build
+ * has POPCNT (the AVX2 build: every AVX2 CPU has it), else the lowest
+ * FEW_LANES bits cleared one by one. */
+static RC__FORCE_INLINE int few_lanes(uint32_t mask)
+{
+#if defined(__POPCNT__)
+    return __builtin_popcount(mask) <= (int)FEW_LANES;
+#else
+    uint32_t j;
+    for (j = 0; j < FEW_LANES; ++j) mask &= mask - 1u;
+    return mask == 0;
+#endif
+}
+
 /* The lanes of mask (at most FEW_LANES), each against the four children of
  * n: met[c] gets the lanes that meet child c, the same bits box_mask gives
  * (the same operations in the same order, from each ray's own origin), tn[c]
@@ -597,19 +611,21 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         packet_entry e[4];
         float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
         uint32_t lanes_met[4] = {0u, 0u, 0u, 0u};
-        uint32_t m = 0, c, j, maybe, rest = mask; /* rest: mask less its FEW_LANES lowest lanes */
-        for (j = 0; j < FEW_LANES; ++j) rest &= rest - 1u;
-        if (rest == 0) {
+        uint32_t m = 0, c, j, maybe;
+        const int few = few_lanes(mask);
+        if (few) {
             /* at most FEW_LANES live lanes: each meets the four boxes at once
              * (the single-ray test), cheaper than every box over all lanes */
             maybe = few_lanes_met(nd, L, T->rays, mask, lanes_met, tn);
         } else {
             maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
         }
-        for (c = 0; c < 4; ++c) {
+        while (maybe) {
             uint32_t mc;
-            if (!((maybe >> c) & 1u) || nd->child[c] == RC__WIDE_EMPTY) continue;
-            mc = rest == 0 ? lanes_met[c] : box_mask(nd, c, L, mask);
+            c = lowest_lane(maybe); /* a child slot here, not a lane */
+            maybe &= maybe - 1u;
+            if (nd->child[c] == RC__WIDE_EMPTY) continue;
+            mc = few ? lanes_met[c] : box_mask(nd, c, L, mask);
             if (!mc) continue;
             /* without turns, fetch what each met child needs first (a node,
              * or a leaf's index triples) now, while the packet works on
