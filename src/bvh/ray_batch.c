@@ -25,7 +25,7 @@ static void prepare_one(const float r[9], const float org[3], const float *d_sen
     rc__ray_prepare(ray, org, dir);
 }
 
-#if defined(RC__RAY_BATCH_SSE2) || defined(RC__RAY_BATCH_NEON)
+#if defined(RC__RAY_BATCH_NEON)
 /* Four prepared rays in lanes: v[0..2] direction, v[3..5] reciprocal,
  * v[6..7] shear sx, sy, v[8] sz; bit i of y_bits / z_bits: ray i's kz is
  * 1 / 2 (else 0); of neg_bits: its component along kz is negative. */
@@ -62,9 +62,30 @@ static void scatter_four(const four_rays *f, const float org[3], rc__ray *rays)
 #endif
 
 #if defined(RC__RAY_BATCH_SSE2)
+#include <stddef.h>
+
 static inline __m128 select_ps(__m128 mask, __m128 a, __m128 b)
 {
     return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
+/* scatter_four's stores as four transposes: a ray's 15 fields are four rows
+ * of four (the last row starts at kz, which it writes again), so each ray
+ * takes four 16-byte stores in place of fifteen scalar ones and the lane
+ * reads that fed them (the scatter was most of this file's instructions). */
+typedef char rc__ray_rows_check[(offsetof(rc__ray, dir) == 12 && offsetof(rc__ray, inv_dir) == 24 &&
+                                 offsetof(rc__ray, kx) == 36 && offsetof(rc__ray, kz) == 44 &&
+                                 offsetof(rc__ray, sx) == 48 && sizeof(rc__ray) == 60)
+                                    ? 1
+                                    : -1];
+
+static void store_four(__m128 a, __m128 b, __m128 c, __m128 d, rc__ray *rays, size_t offset)
+{
+    _MM_TRANSPOSE4_PS(a, b, c, d);
+    _mm_storeu_ps((float *)((char *)&rays[0] + offset), a);
+    _mm_storeu_ps((float *)((char *)&rays[1] + offset), b);
+    _mm_storeu_ps((float *)((char *)&rays[2] + offset), c);
+    _mm_storeu_ps((float *)((char *)&rays[3] + offset), d);
 }
 
 /* Four rays, sensor-frame directions d[0..3], into rays[0..3]. */
@@ -99,20 +120,19 @@ static void prepare_four(const float r[9], const float org[3], const float *cons
     const __m128 neg = _mm_cmplt_ps(dz, _mm_setzero_ps());
     const __m128 sx = _mm_div_ps(select_ps(neg, after, next), dz);
     const __m128 sy = _mm_div_ps(select_ps(neg, next, after), dz);
-    four_rays f;
-    _mm_storeu_ps(f.v[0], wx);
-    _mm_storeu_ps(f.v[1], wy);
-    _mm_storeu_ps(f.v[2], wz);
-    _mm_storeu_ps(f.v[3], ix);
-    _mm_storeu_ps(f.v[4], iy);
-    _mm_storeu_ps(f.v[5], iz);
-    _mm_storeu_ps(f.v[6], sx);
-    _mm_storeu_ps(f.v[7], sy);
-    _mm_storeu_ps(f.v[8], rz);
-    f.y_bits = _mm_movemask_ps(y_only);
-    f.z_bits = _mm_movemask_ps(z_wins);
-    f.neg_bits = _mm_movemask_ps(neg);
-    scatter_four(&f, org, rays);
+    /* kz 0, 1, 2 by y_only and z_wins; kx = kz + 1 and ky = kz + 2 (mod 3),
+     * swapped where neg: the per-ray path's integers, as float bits */
+    const __m128 k0 = _mm_castsi128_ps(_mm_setzero_si128()), k1 = _mm_castsi128_ps(_mm_set1_epi32(1));
+    const __m128 k2 = _mm_castsi128_ps(_mm_set1_epi32(2));
+    const __m128 kz = select_ps(z_wins, k2, select_ps(y_only, k1, k0));
+    const __m128 kx0 = select_ps(z_wins, k0, select_ps(y_only, k2, k1));
+    const __m128 ky0 = select_ps(z_wins, k1, select_ps(y_only, k0, k2));
+    const __m128 kx = select_ps(neg, ky0, kx0), ky = select_ps(neg, kx0, ky0);
+    const __m128 ox = _mm_set1_ps(org[0]), oy = _mm_set1_ps(org[1]), oz = _mm_set1_ps(org[2]);
+    store_four(ox, oy, oz, wx, rays, offsetof(rc__ray, org));
+    store_four(wy, wz, ix, iy, rays, offsetof(rc__ray, dir[1]));
+    store_four(iz, kx, ky, kz, rays, offsetof(rc__ray, inv_dir[2]));
+    store_four(kz, sx, sy, rz, rays, offsetof(rc__ray, kz));
 }
 #endif
 
