@@ -158,17 +158,25 @@ static uint32_t tile_rays(const sim_run *run, const rc__xformf *world, uint32_t 
 {
     const rc_sensor *sensor = run->job->sensor;
     const tiling *tl = &run->tl;
-    uint32_t r0 = (tile / tl->grid_cols) * tl->tile_rows, c0 = (tile % tl->grid_cols) * tl->tile_cols;
+    const uint32_t cols = sensor->columns, r0 = (tile / tl->grid_cols) * tl->tile_rows;
+    const uint32_t c0 = (tile % tl->grid_cols) * tl->tile_cols;
+    /* the tile's clipped extent, and the order table, read once (the stores
+     * to idx would otherwise make the compiler read them again a ray) */
+    const uint32_t rows_in = sensor->rows - r0 < tl->tile_rows ? sensor->rows - r0 : tl->tile_rows;
+    const uint32_t cols_in = cols - c0 < tl->tile_cols ? cols - c0 : tl->tile_cols;
+    const uint64_t *order = sensor->trace_order;
+    const float range_max = sensor->range_max;
     uint32_t n = 0, a, b, i;
-    for (a = 0; a < tl->tile_rows && r0 + a < sensor->rows; ++a)
-        for (b = 0; b < tl->tile_cols && c0 + b < sensor->columns; ++b)
-            idx[n++] = rc__sensor_traced_ray(sensor, (r0 + a) * sensor->columns + c0 + b);
+    for (a = 0; a < rows_in; ++a) {
+        const uint32_t first = (r0 + a) * cols + c0;
+        for (b = 0; b < cols_in; ++b) idx[n++] = order ? (uint32_t)order[first + b] : first + b;
+    }
     if (!sensor->origins) rc__rays_prepare_turned(world->r, world->t, sensor->directions, idx, n, rays);
     for (i = 0; i < n; ++i) {
         if (sensor->origins)
             world_ray_ondn(world, sensor->directions + (size_t)idx[i] * 3u, sensor->origins + (size_t)idx[i] * 3u,
                            &rays[i]);
-        hit_reset(&hits[i], sensor->range_max);
+        hit_reset(&hits[i], range_max);
         found[i] = 0;
     }
     return n;
