@@ -39,29 +39,29 @@ void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out)
 /* rc__write_result given the hit's distance refined in float64
  * (rc__scene_hit_distance_d: it removes the float rounding of the
  * traversal's t) */
+/* The range REP 117 reports for a hit (or none) given its distance refined
+ * in float64; *valid: whether it is a return within the sensor's range. */
+static RC__FORCE_INLINE float refined_range(const rc_sensor *sensor, int found, const rc__hit *hit, double td,
+                                            int *valid)
+{
+    float t = found ? hit->t : 0.0f;
+    /* the plane of the hit triangle in double is the better distance, also
+     * for needles and slivers where the float test's t is coarse; a
+     * non-positive value (origin on the plane) keeps the traversal's t */
+    if (found && td > 0.0 && td < 3.0e38 && (float)td > 0.0f) t = (float)td;
+    *valid = found && t >= sensor->range_min && t <= sensor->range_max;
+    if (*valid) return t;
+    return found && t < sensor->range_min ? -INFINITY : INFINITY;
+}
+
 static RC__FORCE_INLINE void write_refined(const rc__sim_job *job, uint64_t k, const float dir_s[3],
                                            const float *org_s, int found, const rc__hit *hit, double td,
                                            const float n_world_in[3], const rc__xformf *world)
 {
     const rc_results *out = job->out;
     const uint32_t attr = job->attributes;
-    const rc_sensor *sensor = job->sensor;
-    float t = found ? hit->t : 0.0f;
     int valid;
-    float range;
-
-    /* the plane of the hit triangle in double is the better distance, also
-     * for needles and slivers where the float test's t is coarse; a
-     * non-positive value (origin on the plane) keeps the traversal's t */
-    if (found && td > 0.0 && td < 3.0e38 && (float)td > 0.0f) t = (float)td;
-    valid = found && t >= sensor->range_min && t <= sensor->range_max;
-
-    if (valid)
-        range = t;
-    else if (found && t < sensor->range_min)
-        range = -INFINITY;
-    else
-        range = INFINITY;
+    const float range = refined_range(job->sensor, found, hit, td, &valid);
 
     if (attr & RC_ATTR_HITS) out->hits[k] = (uint8_t)valid;
     if (attr & RC_ATTR_RANGES) out->ranges[k] = range;
@@ -123,6 +123,19 @@ void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_
     double td[RC__PACKET_SIZE];
     uint32_t i;
     rc__scene_hit_distances_d(job->scene, hits, found, n, world, directions, idx, td);
+    if (!(job->attributes & ~(uint32_t)(RC_ATTR_HITS | RC_ATTR_RANGES))) {
+        /* ranges and hits only (a localisation filter's call): without
+         * write_refined's tests of the other attributes a ray */
+        uint8_t *const hit_out = job->attributes & RC_ATTR_HITS ? job->out->hits : NULL;
+        float *const range_out = job->attributes & RC_ATTR_RANGES ? job->out->ranges : NULL;
+        for (i = 0; i < n; ++i) {
+            int valid;
+            const float range = refined_range(job->sensor, found[i], &hits[i], td[i], &valid);
+            if (hit_out) hit_out[base + idx[i]] = (uint8_t)valid;
+            if (range_out) range_out[base + idx[i]] = range;
+        }
+        return;
+    }
     for (i = 0; i < n; ++i)
         write_refined(job, base + idx[i], directions + (size_t)idx[i] * 3u, NULL, found[i], &hits[i], td[i], NULL,
                       world);
