@@ -13,6 +13,7 @@
 
 #include "bvh/intersect.h"
 #include "bvh/mesh.h"
+#include "bvh/packet.h"
 #include "core/context.h"
 #include "core/work_order.h"
 #if defined(RANGECAST_WITH_EMBREE)
@@ -22,9 +23,11 @@
 #include "rc_test.h"
 #include "scene/scene.h"
 
-/* 60 VLP-16 poses (900 tiles each): every chunk holds at least 16,384 tiles
- * on 1, 2 and 3 threads, so every call below is ordered */
-#define POSES 60u
+/* VLP-16 poses (14,400 rays, TILES tiles each): 60 of tiles of 16 rays, so
+ * that every chunk holds at least 16,384 tiles on 1, 2 and 3 threads and
+ * every call below is ordered */
+#define TILES (14400u / RC__PACKET_SIZE)
+#define POSES (60u * RC__PACKET_SIZE / 16u)
 
 static rcu_rng rng;
 
@@ -345,7 +348,7 @@ static uint64_t simulate_all(rc_context *ctx, const rc_scene *scene, const rc_se
     return after.arena_peak - before.arena_peak;
 }
 
-/* An OnDn sensor of 14,400 rays (900 runs of 16, as many tiles as a VLP-16
+/* An OnDn sensor of 14,400 rays (TILES runs, as many tiles as a VLP-16
  * has): origins within 1 m, directions sweeping like a scan, so that runs
  * are coherent as an Ouster unit's are. */
 static float ondn_dirs[3u * 14400u], ondn_orgs[3u * 14400u];
@@ -369,12 +372,12 @@ static rc_sensor *make_sensor(rc_context *ctx, int ondn)
 /* Scan order on 1 thread is the reference; ordered calls on 1..3 threads
  * must match it and must have borrowed their scratch (the arena's peak rose
  * by at least 16 bytes a tile of a chunk; Embree's tiles of 8 or 4 rays are
- * more than the built-in backend's 900 a pose). The thresholds are set
+ * more than the built-in backend's TILES a pose). The thresholds are set
  * before commit, where the Embree backend makes its occupancy grid. */
 static void check_ordered(uint32_t backend, const rcu_mesh *sphere, const rcu_mesh *box, const rc_pose *poses,
                           int ondn, int instanced)
 {
-    const uint64_t n = (uint64_t)POSES * 16u * 900u;
+    const uint64_t n = (uint64_t)POSES * 14400u;
     rct_buffers want, got;
     uint32_t threads;
     rct_buffers_alloc(&want, n, RC_ATTR_ALL);
@@ -396,7 +399,7 @@ static void check_ordered(uint32_t backend, const rcu_mesh *sphere, const rcu_me
          * time (2 threads: a map the cache nearly holds) */
         ctx->ordered_turns_bytes = threads == 2u ? UINT64_MAX : 0u;
         borrowed = simulate_all(ctx, scene, sensor, poses, &got);
-        assert_true(borrowed >= (uint64_t)threads * 16u * 900u * ((POSES + threads - 1u) / threads));
+        assert_true(borrowed >= (uint64_t)threads * 16u * TILES * ((POSES + threads - 1u) / threads));
         rct_assert_same_results(&want, &got);
         rc_sensor_destroy(sensor);
         rc_scene_destroy(scene);
@@ -456,7 +459,7 @@ static void test_ordered_matches_scan_order(void **state)
  * the same results and nothing borrowed. */
 static void check_without_room(uint32_t backend)
 {
-    const uint64_t n = (uint64_t)POSES * 16u * 900u;
+    const uint64_t n = (uint64_t)POSES * 14400u;
     rc_pose poses[POSES];
     rct_buffers want, got;
     rcu_mesh sphere;

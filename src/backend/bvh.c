@@ -53,12 +53,13 @@ typedef struct sim_run {
                                       * up to RC__PACKET_MAX_MESHES meshes */
 } sim_run;
 
-/* Tile shape: 16 rays, as close to square in angle as the sensor's grid allows. */
+/* Tile shape: RC__PACKET_SIZE rays, as close to square in angle as the sensor's grid
+ * allows. */
 static void choose_tiling(const rc_sensor *s, tiling *tl)
 {
     double row_step = 1.0, col_step = 1.0, best = 1e300;
     uint32_t tr;
-    if (!rc__sensor_grid_steps(s, &row_step, &col_step)) row_step = 1e9; /* flat rays: runs of 16 */
+    if (!rc__sensor_grid_steps(s, &row_step, &col_step)) row_step = 1e9; /* flat rays: runs of RC__PACKET_SIZE */
     tl->tile_rows = 1;
     for (tr = 1; tr <= RC__PACKET_SIZE; tr *= 2) {
         uint32_t tc = RC__PACKET_SIZE / tr;

@@ -4,7 +4,7 @@
  * each direction component), which holds for every tile of a scan but those
  * that straddle an axis plane. Then each slab's near plane is the same for all
  * lanes, so a node test is (plane - origin) broadcast times each lane's
- * reciprocal: 16 lanes cost a few SIMD instructions. Mixed tiles go ray by ray
+ * reciprocal: 32 lanes cost a few SIMD instructions. Mixed tiles go ray by ray
  * through the single-ray traversal. Either way every ray gets exactly the hit
  * rc__mesh_intersect would give it: box tests only choose which triangles are
  * tested (conservatively), and the triangle test is the same watertight one.
@@ -65,8 +65,8 @@
 /* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
 #define PACKET_STACK (3u * RC__BVH_MAX_DEPTH + 4u)
 #define GROUPS (LANES / 4u)
-/* lanes_tmax's SIMD paths read exactly 16 lanes */
-typedef char rc__packet_lanes_check[LANES == 16u ? 1 : -1];
+/* lane masks are uint32_t, and the AVX2 box tests take rows of eight lanes */
+typedef char rc__packet_lanes_check[LANES <= 32u && LANES % 8u == 0 ? 1 : -1];
 
 typedef struct packet_entry {
     uint32_t child;
@@ -193,7 +193,7 @@ typedef struct packet_bounds {
  * reciprocal, rounding included, so the two products with the packet's
  * smallest and largest reciprocals bound every lane's product exactly as
  * box_mask computes it: a child rejected here is rejected by every lane
- * there. Children of no lane are then skipped without their 16-lane tests.
+ * there. Children of no lane are then skipped without their all-lane tests.
  * tn[c] gets child c's entry bound for the whole packet: the order in which
  * met children are visited (it only orders work; it never culls). */
 static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes *L, const packet_bounds *P,
@@ -289,8 +289,8 @@ static RC__FORCE_INLINE int few_lanes(uint32_t mask)
 static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, const rc__ray *rays,
                                               uint32_t mask, uint32_t met[4], float tn[4])
 {
-    uint64_t fields = 0; /* bits 16c + lane: lane meets child c */
-    uint32_t any = 0, c;
+    uint64_t lo = 0, hi = 0; /* bits 32c + lane (lo: children 0, 1; hi: 2, 3): lane meets child c */
+    uint32_t any = 0;
     int first = 1;
     while (mask) {
         const uint32_t lane = lowest_lane(mask);
@@ -306,17 +306,23 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
         any |= h;
         /* h's bit c moved to bit 16c (h < 16: the four shifted copies do
          * not overlap) */
-        fields |= ((uint64_t)h * 0x0000200040008001u & 0x0001000100010001u) << lane;
+        /* bits 0 and 1 of h to bits 0 and 32 of lo, bits 2 and 3 to those of hi */
+        lo |= ((uint64_t)(h & 3u) * 0x80000001u & 0x100000001u) << lane;
+        hi |= ((uint64_t)(h >> 2) * 0x80000001u & 0x100000001u) << lane;
         if (!first) {
 #if defined(RC__LEAF4_SSE2)
             _mm_store_ps(tn, _mm_min_ps(_mm_load_ps(tl), _mm_load_ps(tn))); /* tl < tn ? tl : tn, NaN too */
 #else
+            uint32_t c;
             for (c = 0; c < 4; ++c) tn[c] = tl[c] < tn[c] ? tl[c] : tn[c];
 #endif
         }
         first = 0;
     }
-    for (c = 0; c < 4; ++c) met[c] |= (uint32_t)(fields >> 16u * c) & 0xFFFFu;
+    met[0] |= (uint32_t)lo;
+    met[1] |= (uint32_t)(lo >> 32);
+    met[2] |= (uint32_t)hi;
+    met[3] |= (uint32_t)(hi >> 32);
     return any;
 }
 
@@ -343,15 +349,18 @@ static inline void lane_set_tmax(packet_lanes *L, uint32_t lane, float t)
 static inline float lanes_tmax(const packet_lanes *L)
 {
 #if defined(RC__PACKET_SSE2)
-    __m128 a = _mm_max_ps(_mm_max_ps(_mm_load_ps(L->tmax), _mm_load_ps(L->tmax + 4)),
-                          _mm_max_ps(_mm_load_ps(L->tmax + 8), _mm_load_ps(L->tmax + 12)));
+    __m128 a = _mm_load_ps(L->tmax);
+    uint32_t q;
+    for (q = 4; q < LANES; q += 4) a = _mm_max_ps(a, _mm_load_ps(L->tmax + q));
     a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(1, 0, 3, 2)));
     a = _mm_max_ps(a, _mm_shuffle_ps(a, a, _MM_SHUFFLE(2, 3, 0, 1)));
     return _mm_cvtss_f32(a);
 #elif defined(RC__PACKET_NEON)
-    const float32x4_t a = vmaxq_f32(vmaxq_f32(vld1q_f32(L->tmax), vld1q_f32(L->tmax + 4)),
-                                    vmaxq_f32(vld1q_f32(L->tmax + 8), vld1q_f32(L->tmax + 12)));
-    const float32x2_t b = vpmax_f32(vget_low_f32(a), vget_high_f32(a));
+    float32x4_t a = vld1q_f32(L->tmax);
+    float32x2_t b;
+    uint32_t q;
+    for (q = 4; q < LANES; q += 4) a = vmaxq_f32(a, vld1q_f32(L->tmax + q));
+    b = vpmax_f32(vget_low_f32(a), vget_high_f32(a));
     return vget_lane_f32(vpmax_f32(b, b), 0);
 #else
     float m = L->tmax[0];

@@ -12,7 +12,11 @@
 #include "bvh/leaf4.h"
 #include "bvh/mesh.h"
 
-#define RC__PACKET_SIZE 16u
+/* 32 rays a packet (16 before session 28): twice the rays share each node
+ * fetch, box test setup and leaf transpose. 2 threads, VLP-16 on the sphere:
+ * 1k +18%, 10k +21%, 100k +5%, 1M +5% (OS1-64 +11%), 10M -4% (noise
+ * 0.87-1.06); docs/benchmarks.md. */
+#define RC__PACKET_SIZE 32u
 
 /* An OnDn sensor whose origins all lie within this of its first (m) traces in
  * packets (own_origins below; the built-in backend decides): the beams of
