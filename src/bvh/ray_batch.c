@@ -8,6 +8,7 @@
  * unpredictable branches on the dominant axis. */
 #include "bvh/mesh.h"
 
+#include "bvh/leaf4.h" /* rc__leaf4_have_avx2 */
 #include "core/rmath.h"
 
 #if defined(__SSE2__) && !defined(RC__PACKET_FORCE_SCALAR)
@@ -79,7 +80,7 @@ typedef char rc__ray_rows_check[(offsetof(rc__ray, dir) == 12 && offsetof(rc__ra
                                     ? 1
                                     : -1];
 
-static void store_four(__m128 a, __m128 b, __m128 c, __m128 d, rc__ray *rays, size_t offset)
+static RC__FORCE_INLINE void store_four(__m128 a, __m128 b, __m128 c, __m128 d, rc__ray *rays, size_t offset)
 {
     _MM_TRANSPOSE4_PS(a, b, c, d);
     _mm_storeu_ps((float *)((char *)&rays[0] + offset), a);
@@ -89,7 +90,7 @@ static void store_four(__m128 a, __m128 b, __m128 c, __m128 d, rc__ray *rays, si
 }
 
 /* Four rays, sensor-frame directions d[0..3], into rays[0..3]. */
-static void prepare_four(const float r[9], const float org[3], const float *const d[4], rc__ray *rays)
+static RC__FORCE_INLINE void prepare_four(const float r[9], const float org[3], const float *const d[4], rc__ray *rays)
 {
     const __m128 one = _mm_set1_ps(1.0f);
     const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7FFFFFFF));
@@ -177,12 +178,13 @@ static void prepare_four(const float r[9], const float org[3], const float *cons
 }
 #endif
 
-void rc__rays_prepare_turned(const float r[9], const float org[3], const float *dirs, const uint32_t *idx,
-                             uint32_t n, rc__ray *rays)
-{
-    uint32_t i = 0;
 #if defined(RC__RAY_BATCH_SSE2) || defined(RC__RAY_BATCH_NEON)
-    for (; i + 4u <= n; i += 4u) {
+/* rays[0..n / 4 * 4): four at a time */
+static RC__FORCE_INLINE uint32_t prepare_fours(const float r[9], const float org[3], const float *dirs,
+                                               const uint32_t *idx, uint32_t n, rc__ray *rays)
+{
+    uint32_t i;
+    for (i = 0; i + 4u <= n; i += 4u) {
         const float *d[4];
         d[0] = dirs + (size_t)idx[i] * 3u;
         d[1] = dirs + (size_t)idx[i + 1u] * 3u;
@@ -190,6 +192,33 @@ void rc__rays_prepare_turned(const float r[9], const float org[3], const float *
         d[3] = dirs + (size_t)idx[i + 3u] * 3u;
         prepare_four(r, org, d, rays + i);
     }
+    return i;
+}
+#endif
+
+#if defined(RC__RAY_BATCH_SSE2) && defined(RC__LEAF4_PAIR_AVX2)
+/* The same SSE2 operations in VEX encoding where the CPU has AVX2: its
+ * three-operand forms drop the register copies that were a quarter of the
+ * two-operand build's instructions (a 1k map: ray preparation -30%). */
+static __attribute__((target("avx2"))) uint32_t prepare_fours_vex(const float r[9], const float org[3],
+                                                                  const float *dirs, const uint32_t *idx, uint32_t n,
+                                                                  rc__ray *rays)
+{
+    return prepare_fours(r, org, dirs, idx, n, rays);
+}
+#endif
+
+void rc__rays_prepare_turned(const float r[9], const float org[3], const float *dirs, const uint32_t *idx,
+                             uint32_t n, rc__ray *rays)
+{
+    uint32_t i = 0;
+#if defined(RC__RAY_BATCH_SSE2) && defined(RC__LEAF4_PAIR_AVX2)
+    if (rc__leaf4_have_avx2())
+        i = prepare_fours_vex(r, org, dirs, idx, n, rays);
+    else
+#endif
+#if defined(RC__RAY_BATCH_SSE2) || defined(RC__RAY_BATCH_NEON)
+        i = prepare_fours(r, org, dirs, idx, n, rays);
 #endif
     for (; i < n; ++i) prepare_one(r, org, dirs + (size_t)idx[i] * 3u, &rays[i]);
 }
