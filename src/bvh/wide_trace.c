@@ -170,8 +170,22 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
     }
 }
 
+#if defined(RC__LEAF4_PAIR_AVX2) && !defined(RC__WIDE_FORCE_SCALAR)
+/* The same traversal in VEX encoding where the CPU has AVX2 (the same SSE2
+ * operations, the same answers): three-operand forms drop the register
+ * copies of the two-operand build. */
+static __attribute__((target("avx2"))) int intersect_wide_vex(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom,
+                                                             uint32_t inst, rc__hit *hit)
+{
+    return wide_traverse(mesh, ray, geom, inst, hit, hit->t, 0);
+}
+#endif
+
 int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst, rc__hit *hit)
 {
+#if defined(RC__LEAF4_PAIR_AVX2) && !defined(RC__WIDE_FORCE_SCALAR)
+    if (rc__leaf4_have_avx2()) return intersect_wide_vex(mesh, ray, geom, inst, hit);
+#endif
     return wide_traverse(mesh, ray, geom, inst, hit, hit->t, 0);
 }
 
