@@ -289,13 +289,35 @@ static RC__FORCE_INLINE int few_lanes(uint32_t mask)
 static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_lanes *L, const rc__ray *rays,
                                               uint32_t mask, uint32_t met[4], float tn[4])
 {
+#if defined(RC__WIDE_BOX_SSE2)
+    /* each lane's four answers as lane masks, ANDed with the lane's bit and
+     * ORed: met[c] in lane c of one register (bits moved one by one into
+     * four words were a quarter of these visits' instructions) */
+    __m128i metv = _mm_loadu_si128((const __m128i *)met);
+    __m128 near = _mm_set1_ps(INFINITY); /* entry distances are never NaN: min(tl, inf) = tl */
+    while (mask) {
+        const uint32_t lane = lowest_lane(mask);
+        float inv[3], tl[4] RC__ALIGN16;
+        __m128 in;
+        mask &= mask - 1u;
+        inv[0] = L->ix[lane];
+        inv[1] = L->iy[lane];
+        inv[2] = L->iz[lane];
+        in = rc__wide_box_lanes(n, L->near_row, rays[lane].org, inv, L->tmax[lane], tl);
+        metv = _mm_or_si128(metv, _mm_and_si128(_mm_castps_si128(in), _mm_set1_epi32((int)(1u << lane))));
+        near = _mm_min_ps(_mm_load_ps(tl), near);
+    }
+    _mm_store_ps(tn, near);
+    _mm_storeu_si128((__m128i *)met, metv);
+    return (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(metv, _mm_setzero_si128()))) ^ 0xFu;
+#else
     uint64_t lo = 0, hi = 0; /* bits 32c + lane (lo: children 0, 1; hi: 2, 3): lane meets child c */
     uint32_t any = 0;
     int first = 1;
     while (mask) {
         const uint32_t lane = lowest_lane(mask);
-        float inv[3], tl[4] RC__ALIGN16;
-        uint32_t h;
+        float inv[3], tl[4];
+        uint32_t h, c;
         mask &= mask - 1u;
         inv[0] = L->ix[lane];
         inv[1] = L->iy[lane];
@@ -304,19 +326,11 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
          * there, on a flag, measured as a mispredicted branch per child) */
         h = rc__wide_box_test(n, L->near_row, rays[lane].org, inv, L->tmax[lane], first ? tn : tl);
         any |= h;
-        /* h's bit c moved to bit 16c (h < 16: the four shifted copies do
-         * not overlap) */
         /* bits 0 and 1 of h to bits 0 and 32 of lo, bits 2 and 3 to those of hi */
         lo |= ((uint64_t)(h & 3u) * 0x80000001u & 0x100000001u) << lane;
         hi |= ((uint64_t)(h >> 2) * 0x80000001u & 0x100000001u) << lane;
-        if (!first) {
-#if defined(RC__LEAF4_SSE2)
-            _mm_store_ps(tn, _mm_min_ps(_mm_load_ps(tl), _mm_load_ps(tn))); /* tl < tn ? tl : tn, NaN too */
-#else
-            uint32_t c;
+        if (!first)
             for (c = 0; c < 4; ++c) tn[c] = tl[c] < tn[c] ? tl[c] : tn[c];
-#endif
-        }
         first = 0;
     }
     met[0] |= (uint32_t)lo;
@@ -324,6 +338,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
     met[2] |= (uint32_t)hi;
     met[3] |= (uint32_t)(hi >> 32);
     return any;
+#endif
 }
 
 /* L->tmax[lane] = t, written as the whole row of four lanes: the box tests

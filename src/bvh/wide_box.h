@@ -20,16 +20,15 @@
 #define RC__WIDE_BOX_NEON 1
 #endif
 
-/* Bit c set when the ray from org with reciprocal direction inv meets child
- * c's box within [0, tmax] (conservatively, Ize's bound); tn[c] gets the
- * entry distance. near_row[k] is the plane row axis k enters by (wide.h). */
-static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uint32_t near_row[3], const float org[3],
-                                                   const float inv[3], float tmax, float tn[4])
+#if defined(RC__WIDE_BOX_SSE2)
+/* rc__wide_box_test's answer before it is read out as bits: lane c all ones
+ * where the ray meets child c (a packet's few lanes gather these: packet.c) */
+static RC__FORCE_INLINE __m128 rc__wide_box_lanes(const rc__wnode *n, const uint32_t near_row[3], const float org[3],
+                                                  const float inv[3], float tmax, float tn[4])
 {
     const float *nx = n->box[near_row[0]], *fx = n->box[near_row[0] ^ 1u];
     const float *ny = n->box[near_row[1]], *fy = n->box[near_row[1] ^ 1u];
     const float *nz = n->box[near_row[2]], *fz = n->box[near_row[2] ^ 1u];
-#if defined(RC__WIDE_BOX_SSE2)
     const __m128 ox = _mm_set1_ps(org[0]), oy = _mm_set1_ps(org[1]), oz = _mm_set1_ps(org[2]);
     const __m128 ix = _mm_set1_ps(inv[0]), iy = _mm_set1_ps(inv[1]), iz = _mm_set1_ps(inv[2]);
     /* max/min return the second operand when the first is NaN (0 * inf: the
@@ -41,8 +40,23 @@ static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uin
     t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nz), oz), iz), t0);
     t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fz), oz), iz), t1);
     _mm_store_ps(tn, t0);
-    return (uint32_t)_mm_movemask_ps(_mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE))));
-#elif defined(RC__WIDE_BOX_NEON)
+    return _mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE)));
+}
+#endif
+
+/* Bit c set when the ray from org with reciprocal direction inv meets child
+ * c's box within [0, tmax] (conservatively, Ize's bound); tn[c] gets the
+ * entry distance. near_row[k] is the plane row axis k enters by (wide.h). */
+static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uint32_t near_row[3], const float org[3],
+                                                   const float inv[3], float tmax, float tn[4])
+{
+#if defined(RC__WIDE_BOX_SSE2)
+    return (uint32_t)_mm_movemask_ps(rc__wide_box_lanes(n, near_row, org, inv, tmax, tn));
+#else
+    const float *nx = n->box[near_row[0]], *fx = n->box[near_row[0] ^ 1u];
+    const float *ny = n->box[near_row[1]], *fy = n->box[near_row[1] ^ 1u];
+    const float *nz = n->box[near_row[2]], *fz = n->box[near_row[2] ^ 1u];
+#if defined(RC__WIDE_BOX_NEON)
     const float32x4_t ox = vdupq_n_f32(org[0]), oy = vdupq_n_f32(org[1]), oz = vdupq_n_f32(org[2]);
     const float32x4_t ix = vdupq_n_f32(inv[0]), iy = vdupq_n_f32(inv[1]), iz = vdupq_n_f32(inv[2]);
     /* SSE2's max and min, so a NaN plane imposes nothing here either */
@@ -73,6 +87,7 @@ static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uin
         if (t0 <= t1 * RC__SLAB_FAR_SCALE) mask |= 1u << c;
     }
     return mask;
+#endif
 #endif
 }
 
