@@ -86,17 +86,45 @@ typedef struct packet_lanes {
 } packet_lanes;
 
 
-/* Lanes of `mask` whose ray meets the box within [0, tmax]. All four groups
- * of lanes are tested, dead ones too: skipping them was a branch per group
- * that mispredicted often enough to cost more than the test. */
-static inline uint32_t box_mask(const rc__wnode *n, uint32_t c, const packet_lanes *L, uint32_t mask)
+/* A node's planes as the packet's box tests take them, once a node: per
+ * axis k, p[k][c] = child c's entry plane less the entry origin, p[3 + k][c]
+ * its exit plane less the exit origin (the interval test reads them as rows,
+ * box_mask child by child; each recomputed them before). */
+typedef struct node_planes {
+    float p[6][4];
+} node_planes;
+
+static inline void planes_fill(const rc__wnode *n, const packet_lanes *L, node_planes *pl)
 {
-    const float nx = n->box[L->near_row[0]][c] - L->org_near[0];
-    const float ny = n->box[L->near_row[1]][c] - L->org_near[1];
-    const float nz = n->box[L->near_row[2]][c] - L->org_near[2];
-    const float fx = n->box[L->near_row[0] ^ 1u][c] - L->org_far[0];
-    const float fy = n->box[L->near_row[1] ^ 1u][c] - L->org_far[1];
-    const float fz = n->box[L->near_row[2] ^ 1u][c] - L->org_far[2];
+    uint32_t k;
+#if defined(RC__PACKET_SSE2)
+    for (k = 0; k < 3; ++k) {
+        _mm_storeu_ps(pl->p[k], _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k]]), _mm_set1_ps(L->org_near[k])));
+        _mm_storeu_ps(pl->p[3 + k], _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k] ^ 1u]), _mm_set1_ps(L->org_far[k])));
+    }
+#elif defined(RC__PACKET_NEON)
+    for (k = 0; k < 3; ++k) {
+        vst1q_f32(pl->p[k], vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), vdupq_n_f32(L->org_near[k])));
+        vst1q_f32(pl->p[3 + k], vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), vdupq_n_f32(L->org_far[k])));
+    }
+#else
+    uint32_t c;
+    for (k = 0; k < 3; ++k)
+        for (c = 0; c < 4; ++c) {
+            pl->p[k][c] = n->box[L->near_row[k]][c] - L->org_near[k];
+            pl->p[3 + k][c] = n->box[L->near_row[k] ^ 1u][c] - L->org_far[k];
+        }
+#endif
+}
+
+/* Lanes of `mask` whose ray meets child c's box (planes pl) within
+ * [0, tmax]. All four groups of lanes are tested, dead ones too: skipping
+ * them was a branch per group that mispredicted often enough to cost more
+ * than the test. */
+static inline uint32_t box_mask(const node_planes *pl, uint32_t c, const packet_lanes *L, uint32_t mask)
+{
+    const float nx = pl->p[0][c], ny = pl->p[1][c], nz = pl->p[2][c];
+    const float fx = pl->p[3][c], fy = pl->p[4][c], fz = pl->p[5][c];
     uint32_t out = 0, g;
 #if defined(RC__PACKET_SSE2)
     /* x86: rows of BOX_W lanes (four in SSE2, eight in the AVX2 build), the
@@ -196,16 +224,14 @@ typedef struct packet_bounds {
  * there. Children of no lane are then skipped without their all-lane tests.
  * tn[c] gets child c's entry bound for the whole packet: the order in which
  * met children are visited (it only orders work; it never culls). */
-static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes *L, const packet_bounds *P,
-                                          float tn[4])
+static inline uint32_t children_maybe_hit(const node_planes *pl, const packet_bounds *P, float tn[4])
 {
 #if defined(RC__PACKET_SSE2)
     __m128 t0 = _mm_setzero_ps(), t1 = _mm_set1_ps(P->tmax);
     uint32_t k;
     for (k = 0; k < 3; ++k) {
         const __m128 lo = _mm_set1_ps(P->ilo[k]), hi = _mm_set1_ps(P->ihi[k]);
-        const __m128 pn = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k]]), _mm_set1_ps(L->org_near[k]));
-        const __m128 pf = _mm_sub_ps(_mm_loadu_ps(n->box[L->near_row[k] ^ 1u]), _mm_set1_ps(L->org_far[k]));
+        const __m128 pn = _mm_loadu_ps(pl->p[k]), pf = _mm_loadu_ps(pl->p[3 + k]);
         t0 = _mm_max_ps(_mm_min_ps(_mm_mul_ps(pn, lo), _mm_mul_ps(pn, hi)), t0);
         t1 = _mm_min_ps(_mm_max_ps(_mm_mul_ps(pf, lo), _mm_mul_ps(pf, hi)), t1);
     }
@@ -216,8 +242,7 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     uint32_t k;
     for (k = 0; k < 3; ++k) {
         const float32x4_t lo = vdupq_n_f32(P->ilo[k]), hi = vdupq_n_f32(P->ihi[k]);
-        const float32x4_t pn = vsubq_f32(vld1q_f32(n->box[L->near_row[k]]), vdupq_n_f32(L->org_near[k]));
-        const float32x4_t pf = vsubq_f32(vld1q_f32(n->box[L->near_row[k] ^ 1u]), vdupq_n_f32(L->org_far[k]));
+        const float32x4_t pn = vld1q_f32(pl->p[k]), pf = vld1q_f32(pl->p[3 + k]);
         const float32x4_t a = vminq_f32(vmulq_f32(pn, lo), vmulq_f32(pn, hi));
         const float32x4_t b = vmaxq_f32(vmulq_f32(pf, lo), vmulq_f32(pf, hi));
         /* selects, as in box_mask: a NaN (0 * inf) imposes nothing, where
@@ -232,8 +257,7 @@ static inline uint32_t children_maybe_hit(const rc__wnode *n, const packet_lanes
     for (c = 0; c < 4; ++c) {
         float t0 = 0.0f, t1 = P->tmax;
         for (k = 0; k < 3; ++k) {
-            const float pn = n->box[L->near_row[k]][c] - L->org_near[k];
-            const float pf = n->box[L->near_row[k] ^ 1u][c] - L->org_far[k];
+            const float pn = pl->p[k][c], pf = pl->p[3 + k][c];
             const float a = pn * P->ilo[k], b = pn * P->ihi[k], d = pf * P->ilo[k], e = pf * P->ihi[k];
             const float lo = a < b ? a : b, hi = d > e ? d : e;
             t0 = lo > t0 ? lo : t0;
@@ -635,6 +659,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         packet_entry e[4];
         float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
         uint32_t lanes_met[4] = {0u, 0u, 0u, 0u};
+        node_planes pl;
         uint32_t m = 0, c, j, maybe;
         const int few = few_lanes(mask);
         if (few) {
@@ -642,14 +667,15 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
              * (the single-ray test), cheaper than every box over all lanes */
             maybe = few_lanes_met(nd, L, T->rays, mask, lanes_met, tn);
         } else {
-            maybe = T->P.usable ? children_maybe_hit(nd, L, &T->P, tn) : 0xFu;
+            planes_fill(nd, L, &pl);
+            maybe = T->P.usable ? children_maybe_hit(&pl, &T->P, tn) : 0xFu;
         }
         while (maybe) {
             uint32_t mc;
             c = lowest_lane(maybe); /* a child slot here, not a lane */
             maybe &= maybe - 1u;
             if (nd->child[c] == RC__WIDE_EMPTY) continue;
-            mc = few ? lanes_met[c] : box_mask(nd, c, L, mask);
+            mc = few ? lanes_met[c] : box_mask(&pl, c, L, mask);
             if (!mc) continue;
             /* without turns, fetch what each met child needs first (a node,
              * or a leaf's index triples) now, while the packet works on
