@@ -23,9 +23,9 @@
 #include "rc_test.h"
 #include "scene/scene.h"
 
-/* VLP-16 poses (14,400 rays, TILES tiles each): 60 of tiles of 16 rays, so
- * that every chunk holds at least 16,384 tiles on 1, 2 and 3 threads and
- * every call below is ordered */
+/* VLP-16 poses (14,400 rays, TILES tiles each): as many tiles as 60 poses
+ * made when tiles had 16 rays, so that every chunk holds at least 16,384
+ * tiles on 1, 2 and 3 threads and every call below is ordered */
 #define TILES (14400u / RC__PACKET_SIZE)
 #define POSES (60u * RC__PACKET_SIZE / 16u)
 

@@ -36,11 +36,10 @@ void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out)
     rc__xform_to_float(&world, out);
 }
 
-/* rc__write_result given the hit's distance refined in float64
- * (rc__scene_hit_distance_d: it removes the float rounding of the
- * traversal's t) */
 /* The range REP 117 reports for a hit (or none) given its distance refined
- * in float64; *valid: whether it is a return within the sensor's range. */
+ * in float64 (rc__scene_hit_distance_d: it removes the float rounding of
+ * the traversal's t); *valid: whether it is a return within the sensor's
+ * range. */
 static RC__FORCE_INLINE float refined_range(const rc_sensor *sensor, int found, const rc__hit *hit, double td,
                                             int *valid)
 {
@@ -54,6 +53,7 @@ static RC__FORCE_INLINE float refined_range(const rc_sensor *sensor, int found, 
     return found && t < sensor->range_min ? -INFINITY : INFINITY;
 }
 
+/* rc__write_result given the hit's refined distance td */
 static RC__FORCE_INLINE void write_refined(const rc__sim_job *job, uint64_t k, const float dir_s[3],
                                            const float *org_s, int found, const rc__hit *hit, double td,
                                            const float n_world_in[3], const rc__xformf *world)
