@@ -23,11 +23,11 @@
 #include "rc_test.h"
 #include "scene/scene.h"
 
-/* VLP-16 poses (14,400 rays, TILES tiles each): as many tiles as 60 poses
- * made when tiles had 16 rays, so that every chunk holds at least 16,384
- * tiles on 1, 2 and 3 threads and every call below is ordered */
+/* 60 VLP-16 poses (14,400 rays, TILES tiles each): every chunk holds at
+ * least the minimum of tiles (16,384 of 16 rays, as many rays in tiles of
+ * RC__PACKET_SIZE) on 1, 2 and 3 threads, so every call below is ordered */
 #define TILES (14400u / RC__PACKET_SIZE)
-#define POSES (60u * RC__PACKET_SIZE / 16u)
+#define POSES 60u
 
 static rcu_rng rng;
 

@@ -322,7 +322,9 @@ static int plan_ordered(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     }
     /* larger than the cache, and large enough that packets take turns */
     if (biggest <= ctx->ordered_mesh_bytes || biggest <= ctx->large_mesh_bytes) return 0;
-    chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles);
+    /* the minimum was measured with tiles of 16 rays: as many rays a chunk */
+    chunk = rc__order_chunk_poses(job->pose_count, threads, run->tiles,
+                                  RC__ORDER_MIN_RECORDS * 16u / RC__PACKET_SIZE);
     if (chunk == 0) return 0;
     run->chunk_poses = chunk;
     run->order_depth = 1;

@@ -478,7 +478,7 @@ rc_status rc__emb_simulate(rc_context *ctx, const rc__sim_job *job)
     run.chunk_poses = 0;
     run.order_scratch = NULL;
     if (run.es->occupancy && d->options.bytes_now + context_mesh_bytes(ctx) > ctx->ordered_mesh_bytes)
-        run.chunk_poses = rc__order_chunk_poses(job->pose_count, threads, run.tiles_per_pose);
+        run.chunk_poses = rc__order_chunk_poses(job->pose_count, threads, run.tiles_per_pose, RC__ORDER_MIN_RECORDS);
     if (run.chunk_poses) {
         run.order_scratch_stride = rc__order_scratch_bytes(run.chunk_poses, run.tiles_per_pose, sizeof(rc__xformf));
         run.order_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run.order_scratch_stride * threads);

@@ -13,8 +13,10 @@
 
 /* Tiles a chunk sorts. Below the minimum a chunk meets each part of the map
  * too seldom to gain (10M sphere, VLP-16, 2 threads: 9 poses a chunk -2%,
- * 25 poses +10%, 100 +27%, 250 +34%); the maximum bounds the scratch (16
- * bytes a tile: 4 MiB a thread). */
+ * 25 poses +10%, 100 +27%, 250 +34%; measured with the built-in backend's
+ * tiles of 16 rays, which passes the minimum for its tiles' size: the same
+ * rays a chunk); the maximum bounds the scratch (16 bytes a tile: 4 MiB a
+ * thread). */
 #define RC__ORDER_MIN_RECORDS 16384u
 #define RC__ORDER_MAX_RECORDS 262144u
 /* Most poses a chunk takes (bounds the transforms' part of the scratch). */
@@ -22,9 +24,10 @@
 
 /* Poses a chunk takes: as few chunks as the cap allows, a multiple of the
  * thread count so that no thread is left with the last one alone; 0 when a
- * chunk would sort too few tiles to gain. (Inline, like the two below: the
+ * chunk would sort fewer than min_records tiles (too few to gain). (Inline, like the two below: the
  * static core library's size is budgeted.) */
-static inline uint32_t rc__order_chunk_poses(uint32_t pose_count, uint32_t threads, uint32_t tiles_per_pose)
+static inline uint32_t rc__order_chunk_poses(uint32_t pose_count, uint32_t threads, uint32_t tiles_per_pose,
+                                             uint32_t min_records)
 {
     uint32_t max_chunk, tasks, chunk;
     if (tiles_per_pose == 0 || threads == 0) return 0;
@@ -34,7 +37,7 @@ static inline uint32_t rc__order_chunk_poses(uint32_t pose_count, uint32_t threa
     tasks = (pose_count + max_chunk - 1u) / max_chunk;
     tasks = (tasks + threads - 1u) / threads * threads;
     chunk = (pose_count + tasks - 1u) / tasks;
-    return (uint64_t)chunk * tiles_per_pose < RC__ORDER_MIN_RECORDS ? 0u : chunk;
+    return (uint64_t)chunk * tiles_per_pose < min_records ? 0u : chunk;
 }
 
 /* A thread's scratch: keys and records, each twice (the sort moves through
