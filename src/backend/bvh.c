@@ -192,9 +192,7 @@ static uint32_t tile_rays(const sim_run *run, const rc__xformf *world, uint32_t 
     uint32_t i;
     if (!sensor->origins) rc__rays_prepare_turned(world->r, world->t, sensor->directions, idx, n, rays);
     for (i = 0; i < n; ++i) {
-        if (sensor->origins)
-            world_ray_ondn(world, sensor->directions + (size_t)idx[i] * 3u, sensor->origins + (size_t)idx[i] * 3u,
-                           &rays[i]);
+        if (sensor->origins) world_ray(sensor, world, &idx[i], &rays[i]);
         hit_reset(&hits[i], range_max);
         found[i] = 0;
     }
