@@ -87,11 +87,12 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
 }
 
 #if defined(RC__HIT_DISTANCES_SSE2)
-/* The refinement of a tile's hits two at a time (rc__scene_hit_distances_d)
+/* The refinement of a tile's hits in groups (rc__scene_hit_distances_d)
  * against rc__scene_hit_distance_d one at a time: the same doubles, for
- * tiles of 1..16 rays with misses and instance hits among them, under a
- * turned pose. */
-static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t rays)
+ * tiles of 1..RC__PACKET_SIZE rays with misses and instance hits among
+ * them, under a turned pose, each ray rep times in a row (rep 4: groups of
+ * four on one triangle, the quad's shared-normal path). */
+static void check_distances_rep(const rc_scene *scene, const rc_sensor *s, uint32_t rays, uint32_t rep)
 {
     const rc_pose pose = rct_pose_ypr(0.5f, -1.0f, 0.3f, 0.9, -0.3, 0.2);
     rc__xformf world;
@@ -103,17 +104,17 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
     rc__sensor_world_xform(s, &pose, &world);
     while (at + n <= rays) {
         for (i = 0; i < n; ++i) {
-            const float *d = s->directions + 3u * (at + i);
+            const float *d = s->directions + 3u * (at + i / rep);
             float dw[3];
             rc__ray r;
-            idx[i] = at + i;
+            idx[i] = at + i / rep;
             rc__rot_apply_f(world.r, d, dw);
             rc__ray_prepare(&r, world.t, dw);
             hits[i].t = RANGE_MAX;
             hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
-            found[i] = (at + i) % 7u != 3u && rc__scene_intersect(scene, &r, &hits[i]);
+            found[i] = idx[i] % 7u != 3u && rc__scene_intersect(scene, &r, &hits[i]);
             /* as Embree's hits come: no leaf slot, the mesh's own triples */
-            if ((at + i) % 3u == 1u) hits[i].slot = RC_INVALID_ID;
+            if (idx[i] % 3u == 1u) hits[i].slot = RC_INVALID_ID;
             insts += found[i] && hits[i].inst != RC_INVALID_ID;
         }
         rc__scene_hit_distances_d(scene, hits, found, n, &world, s->directions, idx, td);
@@ -128,6 +129,12 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
     }
     assert_true(refined > rays / 2u);
     if (scene->inst_count > 0) assert_true(insts > 0);
+}
+
+static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t rays)
+{
+    check_distances_rep(scene, s, rays, 1u);
+    check_distances_rep(scene, s, rays, 4u);
 }
 #endif
 

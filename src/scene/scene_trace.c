@@ -246,15 +246,32 @@ static __attribute__((target("avx2"))) void hit_distance_quad(const rc_scene *sc
 {
     const float *a[4], *b[4], *c[4], *dir[4];
     const double *r = world->rd;
+    const rc__mesh *one = &scene->geoms[0].mesh;
     uint32_t i;
-    for (i = 0; i < 4; ++i) {
-        const rc__hit *h = &hits[at[i]];
-        const rc__mesh *m = &scene->geoms[h->geom].mesh;
-        const uint32_t *tri = hit_triangle(m, h);
-        a[i] = m->vertices + (size_t)tri[0] * m->stride;
-        b[i] = m->vertices + (size_t)tri[1] * m->stride;
-        c[i] = m->vertices + (size_t)tri[2] * m->stride;
-        dir[i] = directions + (size_t)idx[at[i]] * 3u;
+    if (scene->geom_count == 1 && one->leaf_tris && hits[at[0]].slot != RC_INVALID_ID &&
+        hits[at[1]].slot != RC_INVALID_ID && hits[at[2]].slot != RC_INVALID_ID && hits[at[3]].slot != RC_INVALID_ID) {
+        /* one own mesh, every hit with its leaf slot (the built-in
+         * backend's map): the mesh's fields read once, not once a hit */
+        const float *vertices = one->vertices;
+        const uint32_t *leaf_tris = one->leaf_tris;
+        const size_t stride = one->stride;
+        for (i = 0; i < 4; ++i) {
+            const uint32_t *tri = leaf_tris + (size_t)3 * hits[at[i]].slot;
+            a[i] = vertices + (size_t)tri[0] * stride;
+            b[i] = vertices + (size_t)tri[1] * stride;
+            c[i] = vertices + (size_t)tri[2] * stride;
+            dir[i] = directions + (size_t)idx[at[i]] * 3u;
+        }
+    } else {
+        for (i = 0; i < 4; ++i) {
+            const rc__hit *h = &hits[at[i]];
+            const rc__mesh *m = &scene->geoms[h->geom].mesh;
+            const uint32_t *tri = hit_triangle(m, h);
+            a[i] = m->vertices + (size_t)tri[0] * m->stride;
+            b[i] = m->vertices + (size_t)tri[1] * m->stride;
+            c[i] = m->vertices + (size_t)tri[2] * m->stride;
+            dir[i] = directions + (size_t)idx[at[i]] * 3u;
+        }
     }
     {
         const __m256d px = QUAD_PD(dir, 0), py = QUAD_PD(dir, 1), pz = QUAD_PD(dir, 2);
@@ -267,23 +284,44 @@ static __attribute__((target("avx2"))) void hit_distance_quad(const rc_scene *sc
         const __m256d dz = _mm256_add_pd(
             _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r[6]), px), _mm256_mul_pd(_mm256_set1_pd(r[7]), py)),
             _mm256_mul_pd(_mm256_set1_pd(r[8]), pz));
-        const __m256d ax = QUAD_PD(a, 0), ay = QUAD_PD(a, 1), az = QUAD_PD(a, 2);
-        const __m256d e1x = _mm256_sub_pd(QUAD_PD(b, 0), ax), e1y = _mm256_sub_pd(QUAD_PD(b, 1), ay);
-        const __m256d e1z = _mm256_sub_pd(QUAD_PD(b, 2), az), e2x = _mm256_sub_pd(QUAD_PD(c, 0), ax);
-        const __m256d e2y = _mm256_sub_pd(QUAD_PD(c, 1), ay), e2z = _mm256_sub_pd(QUAD_PD(c, 2), az);
-        const __m256d nx = _mm256_sub_pd(_mm256_mul_pd(e1y, e2z), _mm256_mul_pd(e1z, e2y));
-        const __m256d ny = _mm256_sub_pd(_mm256_mul_pd(e1z, e2x), _mm256_mul_pd(e1x, e2z));
-        const __m256d nz = _mm256_sub_pd(_mm256_mul_pd(e1x, e2y), _mm256_mul_pd(e1y, e2x));
-        const __m256d dn =
-            _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
-        const __m256d w = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(nx, _mm256_sub_pd(ax, _mm256_set1_pd(world->td[0]))),
-                          _mm256_mul_pd(ny, _mm256_sub_pd(ay, _mm256_set1_pd(world->td[1])))),
-            _mm256_mul_pd(nz, _mm256_sub_pd(az, _mm256_set1_pd(world->td[2]))));
-        double q[4], d[4];
-        _mm256_storeu_pd(q, _mm256_div_pd(w, dn));
-        _mm256_storeu_pd(d, dn);
-        for (i = 0; i < 4; ++i) td[at[i]] = d[i] == 0.0 || !isfinite(q[i]) ? (double)hits[at[i]].t : q[i];
+        __m256d ax, ay, az, nx, ny, nz, dn, w;
+        double q[4];
+        if (a[0] == a[1] && a[0] == a[2] && a[0] == a[3] && b[0] == b[1] && b[0] == b[2] && b[0] == b[3] &&
+            c[0] == c[1] && c[0] == c[2] && c[0] == c[3]) {
+            /* one triangle for all four (most groups on a small map): its
+             * normal once, by the same operations in scalar doubles, so
+             * the same values */
+            const double sax = a[0][0], say = a[0][1], saz = a[0][2];
+            const double e1x = b[0][0] - sax, e1y = b[0][1] - say, e1z = b[0][2] - saz;
+            const double e2x = c[0][0] - sax, e2y = c[0][1] - say, e2z = c[0][2] - saz;
+            ax = _mm256_set1_pd(sax), ay = _mm256_set1_pd(say), az = _mm256_set1_pd(saz);
+            nx = _mm256_set1_pd(e1y * e2z - e1z * e2y);
+            ny = _mm256_set1_pd(e1z * e2x - e1x * e2z);
+            nz = _mm256_set1_pd(e1x * e2y - e1y * e2x);
+        } else {
+            __m256d e1x, e1y, e1z, e2x, e2y, e2z;
+            ax = QUAD_PD(a, 0), ay = QUAD_PD(a, 1), az = QUAD_PD(a, 2);
+            e1x = _mm256_sub_pd(QUAD_PD(b, 0), ax), e1y = _mm256_sub_pd(QUAD_PD(b, 1), ay);
+            e1z = _mm256_sub_pd(QUAD_PD(b, 2), az), e2x = _mm256_sub_pd(QUAD_PD(c, 0), ax);
+            e2y = _mm256_sub_pd(QUAD_PD(c, 1), ay), e2z = _mm256_sub_pd(QUAD_PD(c, 2), az);
+            nx = _mm256_sub_pd(_mm256_mul_pd(e1y, e2z), _mm256_mul_pd(e1z, e2y));
+            ny = _mm256_sub_pd(_mm256_mul_pd(e1z, e2x), _mm256_mul_pd(e1x, e2z));
+            nz = _mm256_sub_pd(_mm256_mul_pd(e1x, e2y), _mm256_mul_pd(e1y, e2x));
+        }
+        dn = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
+        w = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, _mm256_sub_pd(ax, _mm256_set1_pd(world->td[0]))),
+                                        _mm256_mul_pd(ny, _mm256_sub_pd(ay, _mm256_set1_pd(world->td[1])))),
+                          _mm256_mul_pd(nz, _mm256_sub_pd(az, _mm256_set1_pd(world->td[2]))));
+        {
+            /* lanes the scalar function would not return w / dn for: dn
+             * zero, or a quotient not finite (NaN or inf: not below inf) */
+            const __m256d quot = _mm256_div_pd(w, dn);
+            const __m256d mag = _mm256_andnot_pd(_mm256_set1_pd(-0.0), quot);
+            const int odd = _mm256_movemask_pd(_mm256_or_pd(_mm256_cmp_pd(dn, _mm256_setzero_pd(), _CMP_EQ_OQ),
+                                                            _mm256_cmp_pd(mag, _mm256_set1_pd(INFINITY), _CMP_NLT_UQ)));
+            _mm256_storeu_pd(q, quot);
+            for (i = 0; i < 4; ++i) td[at[i]] = (odd >> i) & 1 ? (double)hits[at[i]].t : q[i];
+        }
     }
 }
 #undef QUAD_PD
