@@ -488,6 +488,30 @@ typedef struct packet_trav {
 typedef char rc__packet_ray_row_check[offsetof(rc__ray, inv_dir) + 4 * sizeof(float) <= sizeof(rc__ray) ? 1 : -1];
 #endif
 
+#if defined(RC__PACKET_SSE2)
+/* Rays i .. i + 3 into L (lanes past n repeat ray 0 and never hit), and
+ * into lanes_fill's running bounds */
+static RC__FORCE_INLINE void lanes_row(packet_lanes *L, const rc__ray *rays, const rc__hit *hits, uint32_t i, uint32_t n,
+                                      __m128 *lo, __m128 *hi, __m128 *nan, __m128 *tm)
+{
+    __m128 r0 = _mm_loadu_ps(rays[i < n ? i : 0].inv_dir);
+    __m128 r1 = _mm_loadu_ps(rays[i + 1 < n ? i + 1 : 0].inv_dir);
+    __m128 r2 = _mm_loadu_ps(rays[i + 2 < n ? i + 2 : 0].inv_dir);
+    __m128 r3 = _mm_loadu_ps(rays[i + 3 < n ? i + 3 : 0].inv_dir);
+    const __m128 t = _mm_setr_ps(i < n ? hits[i].t : -1.0f, i + 1 < n ? hits[i + 1].t : -1.0f,
+                                 i + 2 < n ? hits[i + 2].t : -1.0f, i + 3 < n ? hits[i + 3].t : -1.0f);
+    *lo = _mm_min_ps(*lo, _mm_min_ps(_mm_min_ps(r0, r1), _mm_min_ps(r2, r3)));
+    *hi = _mm_max_ps(*hi, _mm_max_ps(_mm_max_ps(r0, r1), _mm_max_ps(r2, r3)));
+    *nan = _mm_or_ps(*nan, _mm_or_ps(_mm_cmpunord_ps(r0, r1), _mm_cmpunord_ps(r2, r3)));
+    *tm = _mm_max_ps(*tm, t);
+    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+    _mm_store_ps(L->ix + i, r0);
+    _mm_store_ps(L->iy + i, r1);
+    _mm_store_ps(L->iz + i, r2);
+    _mm_store_ps(L->tmax + i, t);
+}
+#endif
+
 /* Fills L from the packet's rays and P with its bounds: per axis the
  * smallest and largest reciprocal, and the largest tmax. 0 when the rays do
  * not share one octant (L and P are then unusable). Lanes past n repeat ray 0
@@ -507,26 +531,18 @@ static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, ui
     __m128 lo = first, hi = first, nan = _mm_cmpunord_ps(first, first), tm = _mm_set1_ps(hits[0].t);
     float l4[4], h4[4], t4[4];
     int mixed = 0;
-    for (i = 0; i < LANES; i += 4) {
-        __m128 r0 = _mm_loadu_ps(rays[i < n ? i : 0].inv_dir);
-        __m128 r1 = _mm_loadu_ps(rays[i + 1 < n ? i + 1 : 0].inv_dir);
-        __m128 r2 = _mm_loadu_ps(rays[i + 2 < n ? i + 2 : 0].inv_dir);
-        __m128 r3 = _mm_loadu_ps(rays[i + 3 < n ? i + 3 : 0].inv_dir);
-        const __m128 t = _mm_setr_ps(i < n ? hits[i].t : -1.0f, i + 1 < n ? hits[i + 1].t : -1.0f,
-                                     i + 2 < n ? hits[i + 2].t : -1.0f, i + 3 < n ? hits[i + 3].t : -1.0f);
-        /* direction signs by "< 0", as in the single-ray test */
-        mixed |= (_mm_movemask_ps(_mm_cmplt_ps(r0, zero)) ^ neg) | (_mm_movemask_ps(_mm_cmplt_ps(r1, zero)) ^ neg) |
-                 (_mm_movemask_ps(_mm_cmplt_ps(r2, zero)) ^ neg) | (_mm_movemask_ps(_mm_cmplt_ps(r3, zero)) ^ neg);
-        lo = _mm_min_ps(lo, _mm_min_ps(_mm_min_ps(r0, r1), _mm_min_ps(r2, r3)));
-        hi = _mm_max_ps(hi, _mm_max_ps(_mm_max_ps(r0, r1), _mm_max_ps(r2, r3)));
-        nan = _mm_or_ps(nan, _mm_or_ps(_mm_cmpunord_ps(r0, r1), _mm_cmpunord_ps(r2, r3)));
-        tm = _mm_max_ps(tm, t);
-        _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-        _mm_store_ps(L->ix + i, r0);
-        _mm_store_ps(L->iy + i, r1);
-        _mm_store_ps(L->iz + i, r2);
-        _mm_store_ps(L->tmax + i, t);
-    }
+    /* a full tile (most) without the tests for lanes past n */
+    if (n == LANES)
+        for (i = 0; i < LANES; i += 4) lanes_row(L, rays, hits, i, LANES, &lo, &hi, &nan, &tm);
+    else
+        for (i = 0; i < LANES; i += 4) lanes_row(L, rays, hits, i, n, &lo, &hi, &nan, &tm);
+    /* direction signs by "< 0", as in the single-ray test: an axis is
+     * mixed when its smallest reciprocal is negative and its largest not
+     * (lo <= hi); a NaN (never from a finite direction) could hide from
+     * min and max, so then ray by ray */
+    mixed = _mm_movemask_ps(_mm_cmplt_ps(lo, zero)) ^ _mm_movemask_ps(_mm_cmplt_ps(hi, zero));
+    if (_mm_movemask_ps(nan) & 7)
+        for (mixed = 0, i = 0; i < n; ++i) mixed |= octant_of(&rays[i]) ^ neg;
     if (mixed & 7) return 0;
     _mm_storeu_ps(l4, lo);
     _mm_storeu_ps(h4, hi);
