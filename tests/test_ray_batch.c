@@ -1,9 +1,10 @@
-/* rc__rays_prepare_turned (SSE2 / AArch64 NEON, four rays at a time) gives
- * every ray exactly what the per-ray path gives: the turned direction, its
- * reciprocal, the dominant axis, the winding swap and the shear constants, bit
- * for bit, for random turns and directions, axis-aligned and diagonal ones
- * (zeros, -0, ties between components), through an index table, and for
- * counts that are not a multiple of four. */
+/* rc__rays_prepare_turned (SSE2 / AArch64 NEON, four rays at a time; eight
+ * in AVX where the CPU has AVX2) gives every ray exactly what the per-ray
+ * path gives: the turned direction, its reciprocal, the dominant axis, the
+ * winding swap and the shear constants, bit for bit, for random turns and
+ * directions, axis-aligned and diagonal ones (zeros, -0, ties between
+ * components), through an index table, and for counts that are not a
+ * multiple of four or eight. */
 #include <math.h>
 #include <string.h>
 
