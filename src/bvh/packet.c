@@ -644,6 +644,26 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
                                              uint32_t *flat, uint32_t geom, uint32_t inst, int *shrunk)
 {
     uint32_t cand = lo->hit | lo->redo;
+#if defined(RC__LEAF4_FULL)
+    if (cand && !lo->redo && (*known & cand) == cand && !(*flat & cand)) {
+        /* hits the lanes settled, on triangles known not to be flat (most
+         * offers): rc__leaf4_take would take each at the lanes' t, so offer
+         * them straight and set the lane's tmax once */
+        rc__hit *h = &T->hits[lane];
+        int took = 0;
+        while (cand) {
+            const uint32_t c = lowest_lane(cand);
+            cand &= cand - 1u;
+            took |= rc__hit_offer_slot(h, lo->t[c], mesh->bvh.refs, child + c, geom, inst);
+        }
+        if (took) {
+            lane_set_tmax(&T->L, lane, h->t);
+            T->found[lane] = 1;
+            *shrunk = 1;
+        }
+        return;
+    }
+#endif
     while (cand) {
         const uint32_t c = lowest_lane(cand); /* a triangle slot here, not a lane */
         float t;
