@@ -644,11 +644,12 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
                                              uint32_t *flat, uint32_t geom, uint32_t inst, int *shrunk)
 {
     uint32_t cand = lo->hit | lo->redo;
-#if defined(RC__LEAF4_FULL)
+#if defined(RC__LEAF4_FULL) && defined(RC__PACKET_SSE2)
     if (cand && !lo->redo && (*known & cand) == cand && !(*flat & cand)) {
         /* hits the lanes settled, on triangles known not to be flat (most
          * offers): rc__leaf4_take would take each at the lanes' t, so offer
-         * them straight and set the lane's tmax once */
+         * them straight and set the lane's tmax once (x86 only: 288 bytes
+         * that the aarch64 core's size budget does not have) */
         rc__hit *h = &T->hits[lane];
         int took = 0;
         while (cand) {
