@@ -187,153 +187,104 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
 }
 
 #if defined(RC__HIT_DISTANCES_SSE2)
-/* Two hits' vertices, converted to double, one hit a lane */
-#define PAIR_PD(p, q, k) _mm_setr_pd((double)(p)[k], (double)(q)[k])
-
-/* rc__scene_hit_distance_d of hits i and j (own meshes, shared origin) in
- * the two lanes of SSE2 doubles: the same operations in the same order, so
- * each lane is the scalar function's value bit for bit. */
-static void hit_distance_pair(const rc_scene *scene, const rc__hit *hi, const rc__hit *hj, const rc__xformf *world,
-                              const float *di, const float *dj, double *ti, double *tj)
-{
-    const rc__mesh *mi = &scene->geoms[hi->geom].mesh, *mj = &scene->geoms[hj->geom].mesh;
-    const uint32_t *tri_i = hit_triangle(mi, hi), *tri_j = hit_triangle(mj, hj);
-    const float *a0 = mi->vertices + (size_t)tri_i[0] * mi->stride, *a1 = mj->vertices + (size_t)tri_j[0] * mj->stride;
-    const float *b0 = mi->vertices + (size_t)tri_i[1] * mi->stride, *b1 = mj->vertices + (size_t)tri_j[1] * mj->stride;
-    const float *c0 = mi->vertices + (size_t)tri_i[2] * mi->stride, *c1 = mj->vertices + (size_t)tri_j[2] * mj->stride;
-    const double *r = world->rd;
-    const __m128d px = PAIR_PD(di, dj, 0), py = PAIR_PD(di, dj, 1), pz = PAIR_PD(di, dj, 2);
-    const __m128d dx = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[0]), px), _mm_mul_pd(_mm_set1_pd(r[1]), py)),
-                                  _mm_mul_pd(_mm_set1_pd(r[2]), pz));
-    const __m128d dy = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[3]), px), _mm_mul_pd(_mm_set1_pd(r[4]), py)),
-                                  _mm_mul_pd(_mm_set1_pd(r[5]), pz));
-    const __m128d dz = _mm_add_pd(_mm_add_pd(_mm_mul_pd(_mm_set1_pd(r[6]), px), _mm_mul_pd(_mm_set1_pd(r[7]), py)),
-                                  _mm_mul_pd(_mm_set1_pd(r[8]), pz));
-    const __m128d ax = PAIR_PD(a0, a1, 0), ay = PAIR_PD(a0, a1, 1), az = PAIR_PD(a0, a1, 2);
-    const __m128d e1x = _mm_sub_pd(PAIR_PD(b0, b1, 0), ax), e1y = _mm_sub_pd(PAIR_PD(b0, b1, 1), ay);
-    const __m128d e1z = _mm_sub_pd(PAIR_PD(b0, b1, 2), az), e2x = _mm_sub_pd(PAIR_PD(c0, c1, 0), ax);
-    const __m128d e2y = _mm_sub_pd(PAIR_PD(c0, c1, 1), ay), e2z = _mm_sub_pd(PAIR_PD(c0, c1, 2), az);
-    const __m128d nx = _mm_sub_pd(_mm_mul_pd(e1y, e2z), _mm_mul_pd(e1z, e2y));
-    const __m128d ny = _mm_sub_pd(_mm_mul_pd(e1z, e2x), _mm_mul_pd(e1x, e2z));
-    const __m128d nz = _mm_sub_pd(_mm_mul_pd(e1x, e2y), _mm_mul_pd(e1y, e2x));
-    const __m128d dn = _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, dx), _mm_mul_pd(ny, dy)), _mm_mul_pd(nz, dz));
-    const __m128d w =
-        _mm_add_pd(_mm_add_pd(_mm_mul_pd(nx, _mm_sub_pd(ax, _mm_set1_pd(world->td[0]))),
-                              _mm_mul_pd(ny, _mm_sub_pd(ay, _mm_set1_pd(world->td[1])))),
-                   _mm_mul_pd(nz, _mm_sub_pd(az, _mm_set1_pd(world->td[2]))));
-    double q[2], d[2];
-    _mm_storeu_pd(q, _mm_div_pd(w, dn));
-    _mm_storeu_pd(d, dn);
-    *ti = d[0] == 0.0 || !isfinite(q[0]) ? (double)hi->t : q[0];
-    *tj = d[1] == 0.0 || !isfinite(q[1]) ? (double)hj->t : q[1];
-}
-#undef PAIR_PD
+/* Hits refined two at a time in SSE2 doubles (hit_distance_lanes.h) */
+#define RC__HD_NAME distance_lanes2
+#define RC__HD_ATTR
+#define RC__HD_W 2
+#define RC__HD_T __m128d
+#define RC__HD_SET1(x) _mm_set1_pd(x)
+#define RC__HD_ADD(a, b) _mm_add_pd(a, b)
+#define RC__HD_SUB(a, b) _mm_sub_pd(a, b)
+#define RC__HD_MUL(a, b) _mm_mul_pd(a, b)
+#define RC__HD_DIV(a, b) _mm_div_pd(a, b)
+#define RC__HD_GATHER(p, k) _mm_setr_pd((double)(p)[0][k], (double)(p)[1][k])
+/* NLT is true for NaN: a quotient not below inf is inf or NaN */
+#define RC__HD_ODD(dn, q)                                                                                            \
+    _mm_movemask_pd(_mm_or_pd(_mm_cmpeq_pd(dn, _mm_setzero_pd()),                                                   \
+                              _mm_cmpnlt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), q), _mm_set1_pd(INFINITY))))
+#define RC__HD_STORE(p, v) _mm_storeu_pd(p, v)
+#include "scene/hit_distance_lanes.h"
 
 #if defined(RC__LEAF4_PAIR_AVX2)
-/* Four hits' vertex coordinate k, converted to double, one hit a lane */
-#define QUAD_PD(p, k) _mm256_cvtps_pd(_mm_setr_ps((p)[0][k], (p)[1][k], (p)[2][k], (p)[3][k]))
+/* ... and four at a time in AVX doubles where the CPU has AVX2
+ * (rc__leaf4_have_avx2; the target does not enable fused multiply-add) */
+#define RC__HD_NAME distance_lanes4
+#define RC__HD_ATTR __attribute__((target("avx2")))
+#define RC__HD_W 4
+#define RC__HD_T __m256d
+#define RC__HD_SET1(x) _mm256_set1_pd(x)
+#define RC__HD_ADD(a, b) _mm256_add_pd(a, b)
+#define RC__HD_SUB(a, b) _mm256_sub_pd(a, b)
+#define RC__HD_MUL(a, b) _mm256_mul_pd(a, b)
+#define RC__HD_DIV(a, b) _mm256_div_pd(a, b)
+#define RC__HD_GATHER(p, k) _mm256_cvtps_pd(_mm_setr_ps((p)[0][k], (p)[1][k], (p)[2][k], (p)[3][k]))
+#define RC__HD_ODD(dn, q)                                                                                            \
+    _mm256_movemask_pd(_mm256_or_pd(_mm256_cmp_pd(dn, _mm256_setzero_pd(), _CMP_EQ_OQ),                           \
+                                    _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), q),                       \
+                                                  _mm256_set1_pd(INFINITY), _CMP_NLT_UQ)))
+#define RC__HD_STORE(p, v) _mm256_storeu_pd(p, v)
+#include "scene/hit_distance_lanes.h"
+#endif
 
-/* hit_distance_pair for four hits (the hits[at[0..3]]) in AVX doubles, where
- * the CPU has AVX2 (rc__leaf4_have_avx2): again the scalar function's
- * operations in its order, lane for lane, without fused multiply-add (the
- * target does not enable it), so each value is its value bit for bit
- * (session 28: 12% fewer of the refinement's instructions on a 1k map than
- * two at a time; gathering the vertices is most of what is left). */
-static __attribute__((target("avx2"))) void hit_distance_quad(const rc_scene *scene, const rc__hit *hits,
-                                                             const uint32_t at[4], const rc__xformf *world,
-                                                             const float *directions, const uint32_t *idx,
-                                                             double *td)
-{
+/* The vertices of hits[at[0 .. count)] (own meshes) and their sensor
+ * directions */
+typedef struct hit_group {
     const float *a[4], *b[4], *c[4], *dir[4];
-    const double *r = world->rd;
+} hit_group;
+
+static RC__FORCE_INLINE void group_fill(const rc_scene *scene, const rc__hit *hits, const uint32_t *at, uint32_t count,
+                                        const float *directions, const uint32_t *idx, hit_group *g)
+{
     const rc__mesh *one = &scene->geoms[0].mesh;
-    uint32_t i;
-    if (scene->geom_count == 1 && one->leaf_tris && hits[at[0]].slot != RC_INVALID_ID &&
-        hits[at[1]].slot != RC_INVALID_ID && hits[at[2]].slot != RC_INVALID_ID && hits[at[3]].slot != RC_INVALID_ID) {
+    uint32_t i, slots = 1;
+    for (i = 0; i < count; ++i) {
+        g->dir[i] = directions + (size_t)idx[at[i]] * 3u;
+        slots &= hits[at[i]].slot != RC_INVALID_ID;
+    }
+    if (scene->geom_count == 1 && one->leaf_tris && slots) {
         /* one own mesh, every hit with its leaf slot (the built-in
          * backend's map): the mesh's fields read once, not once a hit */
         const float *vertices = one->vertices;
         const uint32_t *leaf_tris = one->leaf_tris;
         const size_t stride = one->stride;
-        for (i = 0; i < 4; ++i) {
+        for (i = 0; i < count; ++i) {
             const uint32_t *tri = leaf_tris + (size_t)3 * hits[at[i]].slot;
-            a[i] = vertices + (size_t)tri[0] * stride;
-            b[i] = vertices + (size_t)tri[1] * stride;
-            c[i] = vertices + (size_t)tri[2] * stride;
-            dir[i] = directions + (size_t)idx[at[i]] * 3u;
+            g->a[i] = vertices + (size_t)tri[0] * stride;
+            g->b[i] = vertices + (size_t)tri[1] * stride;
+            g->c[i] = vertices + (size_t)tri[2] * stride;
         }
-    } else {
-        for (i = 0; i < 4; ++i) {
-            const rc__hit *h = &hits[at[i]];
-            const rc__mesh *m = &scene->geoms[h->geom].mesh;
-            const uint32_t *tri = hit_triangle(m, h);
-            a[i] = m->vertices + (size_t)tri[0] * m->stride;
-            b[i] = m->vertices + (size_t)tri[1] * m->stride;
-            c[i] = m->vertices + (size_t)tri[2] * m->stride;
-            dir[i] = directions + (size_t)idx[at[i]] * 3u;
-        }
+        return;
     }
-    {
-        const __m256d px = QUAD_PD(dir, 0), py = QUAD_PD(dir, 1), pz = QUAD_PD(dir, 2);
-        const __m256d dx = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r[0]), px), _mm256_mul_pd(_mm256_set1_pd(r[1]), py)),
-            _mm256_mul_pd(_mm256_set1_pd(r[2]), pz));
-        const __m256d dy = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r[3]), px), _mm256_mul_pd(_mm256_set1_pd(r[4]), py)),
-            _mm256_mul_pd(_mm256_set1_pd(r[5]), pz));
-        const __m256d dz = _mm256_add_pd(
-            _mm256_add_pd(_mm256_mul_pd(_mm256_set1_pd(r[6]), px), _mm256_mul_pd(_mm256_set1_pd(r[7]), py)),
-            _mm256_mul_pd(_mm256_set1_pd(r[8]), pz));
-        __m256d ax, ay, az, nx, ny, nz, dn, w;
-        double q[4];
-        if (a[0] == a[1] && a[0] == a[2] && a[0] == a[3] && b[0] == b[1] && b[0] == b[2] && b[0] == b[3] &&
-            c[0] == c[1] && c[0] == c[2] && c[0] == c[3]) {
-            /* one triangle for all four (most groups on a small map): its
-             * normal once, by the same operations in scalar doubles, so
-             * the same values */
-            const double sax = a[0][0], say = a[0][1], saz = a[0][2];
-            const double e1x = b[0][0] - sax, e1y = b[0][1] - say, e1z = b[0][2] - saz;
-            const double e2x = c[0][0] - sax, e2y = c[0][1] - say, e2z = c[0][2] - saz;
-            ax = _mm256_set1_pd(sax), ay = _mm256_set1_pd(say), az = _mm256_set1_pd(saz);
-            nx = _mm256_set1_pd(e1y * e2z - e1z * e2y);
-            ny = _mm256_set1_pd(e1z * e2x - e1x * e2z);
-            nz = _mm256_set1_pd(e1x * e2y - e1y * e2x);
-        } else {
-            __m256d e1x, e1y, e1z, e2x, e2y, e2z;
-            ax = QUAD_PD(a, 0), ay = QUAD_PD(a, 1), az = QUAD_PD(a, 2);
-            e1x = _mm256_sub_pd(QUAD_PD(b, 0), ax), e1y = _mm256_sub_pd(QUAD_PD(b, 1), ay);
-            e1z = _mm256_sub_pd(QUAD_PD(b, 2), az), e2x = _mm256_sub_pd(QUAD_PD(c, 0), ax);
-            e2y = _mm256_sub_pd(QUAD_PD(c, 1), ay), e2z = _mm256_sub_pd(QUAD_PD(c, 2), az);
-            nx = _mm256_sub_pd(_mm256_mul_pd(e1y, e2z), _mm256_mul_pd(e1z, e2y));
-            ny = _mm256_sub_pd(_mm256_mul_pd(e1z, e2x), _mm256_mul_pd(e1x, e2z));
-            nz = _mm256_sub_pd(_mm256_mul_pd(e1x, e2y), _mm256_mul_pd(e1y, e2x));
-        }
-        dn = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, dx), _mm256_mul_pd(ny, dy)), _mm256_mul_pd(nz, dz));
-        w = _mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(nx, _mm256_sub_pd(ax, _mm256_set1_pd(world->td[0]))),
-                                        _mm256_mul_pd(ny, _mm256_sub_pd(ay, _mm256_set1_pd(world->td[1])))),
-                          _mm256_mul_pd(nz, _mm256_sub_pd(az, _mm256_set1_pd(world->td[2]))));
-        {
-            /* lanes the scalar function would not return w / dn for: dn
-             * zero, or a quotient not finite (NaN or inf: not below inf) */
-            const __m256d quot = _mm256_div_pd(w, dn);
-            const __m256d mag = _mm256_andnot_pd(_mm256_set1_pd(-0.0), quot);
-            const int odd = _mm256_movemask_pd(_mm256_or_pd(_mm256_cmp_pd(dn, _mm256_setzero_pd(), _CMP_EQ_OQ),
-                                                            _mm256_cmp_pd(mag, _mm256_set1_pd(INFINITY), _CMP_NLT_UQ)));
-            _mm256_storeu_pd(q, quot);
-            for (i = 0; i < 4; ++i) td[at[i]] = (odd >> i) & 1 ? (double)hits[at[i]].t : q[i];
-        }
+    for (i = 0; i < count; ++i) {
+        const rc__hit *h = &hits[at[i]];
+        const rc__mesh *m = &scene->geoms[h->geom].mesh;
+        const uint32_t *tri = hit_triangle(m, h);
+        g->a[i] = m->vertices + (size_t)tri[0] * m->stride;
+        g->b[i] = m->vertices + (size_t)tri[1] * m->stride;
+        g->c[i] = m->vertices + (size_t)tri[2] * m->stride;
     }
 }
-#undef QUAD_PD
-#endif
 
-/* hit_distance_pair for hits[a] and hits[b] */
-static void pair_at(const rc_scene *scene, const rc__hit *hits, uint32_t a, uint32_t b, const rc__xformf *world,
-                    const float *directions, const uint32_t *idx, double *td)
+/* rc__scene_hit_distance_d of hits at[0], at[1] */
+static void refine_two(const rc_scene *scene, const rc__hit *hits, const uint32_t *at, const rc__xformf *world,
+                       const float *directions, const uint32_t *idx, double *td)
 {
-    hit_distance_pair(scene, &hits[a], &hits[b], world, directions + (size_t)idx[a] * 3u,
-                      directions + (size_t)idx[b] * 3u, &td[a], &td[b]);
+    hit_group g;
+    group_fill(scene, hits, at, 2u, directions, idx, &g);
+    distance_lanes2(g.a, g.b, g.c, g.dir, world, hits, at, td);
 }
+
+#if defined(RC__LEAF4_PAIR_AVX2)
+/* ... of hits at[0 .. 4), all of it in VEX encoding */
+static __attribute__((target("avx2"))) void refine_four(const rc_scene *scene, const rc__hit *hits,
+                                                       const uint32_t *at, const rc__xformf *world,
+                                                       const float *directions, const uint32_t *idx, double *td)
+{
+    hit_group g;
+    group_fill(scene, hits, at, 4u, directions, idx, &g);
+    distance_lanes4(g.a, g.b, g.c, g.dir, world, hits, at, td);
+}
+#endif
 
 void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const int *found, uint32_t n,
                                const rc__xformf *world, const float *directions, const uint32_t *idx, double *td)
@@ -355,14 +306,14 @@ void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const
             if (k < group) continue;
 #if defined(RC__LEAF4_PAIR_AVX2)
             if (group == 4u)
-                hit_distance_quad(scene, hits, own, world, directions, idx, td);
+                refine_four(scene, hits, own, world, directions, idx, td);
             else
 #endif
-                pair_at(scene, hits, own[0], own[1], world, directions, idx, td);
+                refine_two(scene, hits, own, world, directions, idx, td);
             k = 0;
         }
     }
-    for (i = 0; i + 1u < k; i += 2u) pair_at(scene, hits, own[i], own[i + 1u], world, directions, idx, td);
+    for (i = 0; i + 1u < k; i += 2u) refine_two(scene, hits, own + i, world, directions, idx, td);
     if (k & 1u)
         td[own[k - 1u]] =
             rc__scene_hit_distance_d(scene, &hits[own[k - 1u]], world, directions + (size_t)idx[own[k - 1u]] * 3u, NULL);

@@ -1,0 +1,80 @@
+/* The body of the float64 refinement of several hits at once (scene_trace.c),
+ * written once for both widths: two hits in SSE2 doubles, and four in AVX
+ * doubles where the CPU has AVX2. No include guard: the includer defines
+ * RC__HD_NAME (the function's name), RC__HD_ATTR (attributes beyond static
+ * inline), RC__HD_W (hits), the vector type RC__HD_T, the operations below,
+ * and includes this file, which undefines them all at its end.
+ *
+ *   SET1(x) ADD SUB MUL DIV    IEEE double precision, no contraction
+ *   GATHER(p, k)               coordinate k of p[0 .. W), widened, one a lane
+ *   ODD(dn, q)                 bit i: lane i's dn is zero or q is not finite
+ *   STORE(p, v)                the lanes of v to p[0 .. W)
+ *
+ * Lane i repeats rc__scene_hit_distance_d's operations in their order for a
+ * hit on the triangle a[i], b[i], c[i] (own mesh) along the sensor direction
+ * dir[i] (hits[at[i]]), so each value is that function's bit for bit
+ * (tests/test_simulate_paths.c); td[at[i]] gets it, or the traversal's
+ * distance where that function keeps it. */
+static RC__FORCE_INLINE RC__HD_ATTR void RC__HD_NAME(const float *const a[RC__HD_W], const float *const b[RC__HD_W],
+                                                     const float *const c[RC__HD_W], const float *const dir[RC__HD_W],
+                                                     const rc__xformf *world, const rc__hit *hits,
+                                                     const uint32_t *at, double *td)
+{
+    const double *r = world->rd;
+    const RC__HD_T px = RC__HD_GATHER(dir, 0), py = RC__HD_GATHER(dir, 1), pz = RC__HD_GATHER(dir, 2);
+    /* the sensor direction turned into the scene frame, as rot_d */
+    const RC__HD_T dx = RC__HD_ADD(RC__HD_ADD(RC__HD_MUL(RC__HD_SET1(r[0]), px), RC__HD_MUL(RC__HD_SET1(r[1]), py)),
+                                   RC__HD_MUL(RC__HD_SET1(r[2]), pz));
+    const RC__HD_T dy = RC__HD_ADD(RC__HD_ADD(RC__HD_MUL(RC__HD_SET1(r[3]), px), RC__HD_MUL(RC__HD_SET1(r[4]), py)),
+                                   RC__HD_MUL(RC__HD_SET1(r[5]), pz));
+    const RC__HD_T dz = RC__HD_ADD(RC__HD_ADD(RC__HD_MUL(RC__HD_SET1(r[6]), px), RC__HD_MUL(RC__HD_SET1(r[7]), py)),
+                                   RC__HD_MUL(RC__HD_SET1(r[8]), pz));
+    RC__HD_T ax, ay, az, nx, ny, nz, dn, w;
+    double q[RC__HD_W];
+    int same = 1, i, odd;
+    for (i = 1; i < RC__HD_W; ++i) same &= a[i] == a[0] && b[i] == b[0] && c[i] == c[0];
+    if (same) {
+        /* one triangle for every lane (most groups on a small map): its
+         * normal once, by the same operations in scalar doubles, so the
+         * same values */
+        const double sax = a[0][0], say = a[0][1], saz = a[0][2];
+        const double e1x = b[0][0] - sax, e1y = b[0][1] - say, e1z = b[0][2] - saz;
+        const double e2x = c[0][0] - sax, e2y = c[0][1] - say, e2z = c[0][2] - saz;
+        ax = RC__HD_SET1(sax), ay = RC__HD_SET1(say), az = RC__HD_SET1(saz);
+        nx = RC__HD_SET1(e1y * e2z - e1z * e2y);
+        ny = RC__HD_SET1(e1z * e2x - e1x * e2z);
+        nz = RC__HD_SET1(e1x * e2y - e1y * e2x);
+    } else {
+        RC__HD_T e1x, e1y, e1z, e2x, e2y, e2z;
+        ax = RC__HD_GATHER(a, 0), ay = RC__HD_GATHER(a, 1), az = RC__HD_GATHER(a, 2);
+        e1x = RC__HD_SUB(RC__HD_GATHER(b, 0), ax), e1y = RC__HD_SUB(RC__HD_GATHER(b, 1), ay);
+        e1z = RC__HD_SUB(RC__HD_GATHER(b, 2), az), e2x = RC__HD_SUB(RC__HD_GATHER(c, 0), ax);
+        e2y = RC__HD_SUB(RC__HD_GATHER(c, 1), ay), e2z = RC__HD_SUB(RC__HD_GATHER(c, 2), az);
+        nx = RC__HD_SUB(RC__HD_MUL(e1y, e2z), RC__HD_MUL(e1z, e2y));
+        ny = RC__HD_SUB(RC__HD_MUL(e1z, e2x), RC__HD_MUL(e1x, e2z));
+        nz = RC__HD_SUB(RC__HD_MUL(e1x, e2y), RC__HD_MUL(e1y, e2x));
+    }
+    dn = RC__HD_ADD(RC__HD_ADD(RC__HD_MUL(nx, dx), RC__HD_MUL(ny, dy)), RC__HD_MUL(nz, dz));
+    w = RC__HD_ADD(RC__HD_ADD(RC__HD_MUL(nx, RC__HD_SUB(ax, RC__HD_SET1(world->td[0]))),
+                              RC__HD_MUL(ny, RC__HD_SUB(ay, RC__HD_SET1(world->td[1])))),
+                   RC__HD_MUL(nz, RC__HD_SUB(az, RC__HD_SET1(world->td[2]))));
+    {
+        const RC__HD_T quot = RC__HD_DIV(w, dn);
+        odd = RC__HD_ODD(dn, quot);
+        RC__HD_STORE(q, quot);
+    }
+    for (i = 0; i < RC__HD_W; ++i) td[at[i]] = (odd >> i) & 1 ? (double)hits[at[i]].t : q[i];
+}
+
+#undef RC__HD_NAME
+#undef RC__HD_ATTR
+#undef RC__HD_W
+#undef RC__HD_T
+#undef RC__HD_SET1
+#undef RC__HD_ADD
+#undef RC__HD_SUB
+#undef RC__HD_MUL
+#undef RC__HD_DIV
+#undef RC__HD_GATHER
+#undef RC__HD_ODD
+#undef RC__HD_STORE
