@@ -172,6 +172,20 @@ static uint32_t tile_indices(const sim_run *run, uint32_t tile, uint32_t idx[RC_
     return n;
 }
 
+/* tile_indices(run, tile, idx)[n / 2], the tile's middle ray, without the
+ * others (ordered runs key each tile by it) */
+static uint32_t tile_middle(const sim_run *run, uint32_t tile)
+{
+    const rc_sensor *sensor = run->job->sensor;
+    const tiling *tl = &run->tl;
+    const uint32_t cols = sensor->columns, r0 = (tile / tl->grid_cols) * tl->tile_rows;
+    const uint32_t c0 = (tile % tl->grid_cols) * tl->tile_cols;
+    const uint32_t rows_in = sensor->rows - r0 < tl->tile_rows ? sensor->rows - r0 : tl->tile_rows;
+    const uint32_t cols_in = cols - c0 < tl->tile_cols ? cols - c0 : tl->tile_cols;
+    const uint32_t m = rows_in * cols_in / 2u, at = (r0 + m / cols_in) * cols + c0 + m % cols_in;
+    return sensor->trace_order ? (uint32_t)sensor->trace_order[at] : at;
+}
+
 /* Ray idx of the sensor in the map frame, as tile_rays turns it. */
 static void world_ray(const rc_sensor *sensor, const rc__xformf *world, const uint32_t *idx, rc__ray *ray)
 {
@@ -283,10 +297,9 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
         for (t = 0; t < run->tiles; ++t) {
             /* the tile's middle ray, as the traversal will turn it (only
              * that one: preparing the whole tile twice was 4% of a 1M call) */
-            uint32_t idx[RC__PACKET_SIZE], i = p * run->tiles + t;
-            const uint32_t n = tile_indices(run, t, idx);
+            const uint32_t i = p * run->tiles + t, mid = tile_middle(run, t);
             rc__ray ray;
-            world_ray(sensor, &worlds[p], &idx[n / 2u], &ray);
+            world_ray(sensor, &worlds[p], &mid, &ray);
             keys[i] = rc__mesh_order_key(mesh, &ray, sensor->range_max, run->order_depth);
             recs[i] = i;
         }
