@@ -152,21 +152,38 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
     }
 }
 
+/* A tile's place in the scan: its first row and column, and how many of
+ * its rows and columns the scan holds (the last tiles may be clipped). */
+typedef struct tile_extent {
+    uint32_t r0, c0, rows_in, cols_in;
+} tile_extent;
+
+static RC__FORCE_INLINE void tile_extent_of(const sim_run *run, uint32_t tile, tile_extent *e)
+{
+    const rc_sensor *sensor = run->job->sensor;
+    const tiling *tl = &run->tl;
+    e->r0 = (tile / tl->grid_cols) * tl->tile_rows;
+    e->c0 = (tile % tl->grid_cols) * tl->tile_cols;
+    e->rows_in = sensor->rows - e->r0 < tl->tile_rows ? sensor->rows - e->r0 : tl->tile_rows;
+    e->cols_in = sensor->columns - e->c0 < tl->tile_cols ? sensor->columns - e->c0 : tl->tile_cols;
+}
+
 /* The sensor's ray indices of one tile, in tracing order; returns the count. */
 static uint32_t tile_indices(const sim_run *run, uint32_t tile, uint32_t idx[RC__PACKET_SIZE])
 {
     const rc_sensor *sensor = run->job->sensor;
-    const tiling *tl = &run->tl;
-    const uint32_t cols = sensor->columns, r0 = (tile / tl->grid_cols) * tl->tile_rows;
-    const uint32_t c0 = (tile % tl->grid_cols) * tl->tile_cols;
-    /* the tile's clipped extent, and the order table, read once (the stores
-     * to idx would otherwise make the compiler read them again a ray) */
-    const uint32_t rows_in = sensor->rows - r0 < tl->tile_rows ? sensor->rows - r0 : tl->tile_rows;
-    const uint32_t cols_in = cols - c0 < tl->tile_cols ? cols - c0 : tl->tile_cols;
+    const uint32_t cols = sensor->columns;
+    /* the tile's extent and the order table in locals, read once (the
+     * stores to idx would otherwise make the compiler read them again a
+     * ray) */
+    tile_extent e;
     const uint64_t *order = sensor->trace_order;
-    uint32_t n = 0, a, b;
+    uint32_t n = 0, a, b, rows_in, cols_in;
+    tile_extent_of(run, tile, &e);
+    rows_in = e.rows_in;
+    cols_in = e.cols_in;
     for (a = 0; a < rows_in; ++a) {
-        const uint32_t first = (r0 + a) * cols + c0;
+        const uint32_t first = (e.r0 + a) * cols + e.c0;
         for (b = 0; b < cols_in; ++b) idx[n++] = order ? (uint32_t)order[first + b] : first + b;
     }
     return n;
@@ -177,12 +194,11 @@ static uint32_t tile_indices(const sim_run *run, uint32_t tile, uint32_t idx[RC_
 static uint32_t tile_middle(const sim_run *run, uint32_t tile)
 {
     const rc_sensor *sensor = run->job->sensor;
-    const tiling *tl = &run->tl;
-    const uint32_t cols = sensor->columns, r0 = (tile / tl->grid_cols) * tl->tile_rows;
-    const uint32_t c0 = (tile % tl->grid_cols) * tl->tile_cols;
-    const uint32_t rows_in = sensor->rows - r0 < tl->tile_rows ? sensor->rows - r0 : tl->tile_rows;
-    const uint32_t cols_in = cols - c0 < tl->tile_cols ? cols - c0 : tl->tile_cols;
-    const uint32_t m = rows_in * cols_in / 2u, at = (r0 + m / cols_in) * cols + c0 + m % cols_in;
+    tile_extent e;
+    uint32_t m, at;
+    tile_extent_of(run, tile, &e);
+    m = e.rows_in * e.cols_in / 2u;
+    at = (e.r0 + m / e.cols_in) * sensor->columns + e.c0 + m % e.cols_in;
     return sensor->trace_order ? (uint32_t)sensor->trace_order[at] : at;
 }
 
