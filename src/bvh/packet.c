@@ -478,8 +478,8 @@ typedef struct packet_trav {
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
-    /* up to three pushes per level */
-    packet_entry stack[PACKET_STACK];
+    /* up to three pushes per level, and room for one node's children past the end */
+    packet_entry stack[PACKET_STACK + 4u];
 } packet_trav;
 
 #if defined(RC__PACKET_SSE2)
@@ -686,14 +686,17 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     const rc__wnode *nodes = mesh->wide;
     packet_lanes *L = &T->L;
     uint32_t child = T->child, mask = T->mask;
-    if (T->settling) {
+    /* settling and staged belong to turns: a packet alone never sets them */
+    if (interleaved && T->settling) {
         uint32_t i;
         for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
         return 0;
     }
     if (T->count == 0) {
         const rc__wnode *nd = &nodes[child];
-        packet_entry e[4];
+        /* the met children go straight onto the stack, farthest first: the
+         * last is visited next, the others stay pushed */
+        packet_entry *const S = T->stack + T->sp;
         float tn[4] RC__ALIGN16 = {0.0f, 0.0f, 0.0f, 0.0f};
         uint32_t lanes_met[4] = {0u, 0u, 0u, 0u};
         node_planes pl;
@@ -721,27 +724,28 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
              * (1M sphere, under the turns' threshold here: +9-17%; 1k-100k,
              * and 10M with turns, within noise) */
             if (!interleaved) rc__prefetch_next(nodes, mesh->leaf_tris, nd->child[c], nd->count[c]);
-            e[m].child = nd->child[c];
-            e[m].count = nd->count[c];
-            e[m].mask = mc;
-            e[m].tmin = tn[c];
-            /* keep e sorted by the packet's smallest entry distance */
-            for (j = m; j > 0 && e[j].tmin < e[j - 1].tmin; --j) {
-                const packet_entry tmp = e[j];
-                e[j] = e[j - 1];
-                e[j - 1] = tmp;
+            {
+                /* sorted by the packet's smallest entry distance, nearest on
+                 * top; of equal ones the earlier is visited first */
+                packet_entry x;
+                x.child = nd->child[c];
+                x.count = nd->count[c];
+                x.mask = mc;
+                x.tmin = tn[c];
+                for (j = m; j > 0 && S[j - 1].tmin <= x.tmin; --j) S[j] = S[j - 1];
+                S[j] = x;
+                ++m;
             }
-            ++m;
         }
         if (m > 0) {
-            /* the builder caps depth so this always holds; a deeper tree (a
-             * hostile baked map) loses branches instead of the stack */
-            for (j = m; j-- > 1;)
-                if (RC__LIKELY(T->sp < PACKET_STACK)) T->stack[T->sp++] = e[j];
-            T->child = e[0].child;
-            T->count = e[0].count;
-            T->mask = e[0].mask;
-            T->staged = 0;
+            T->child = S[m - 1].child;
+            T->count = S[m - 1].count;
+            T->mask = S[m - 1].mask;
+            /* the builder caps depth so the pushes fit; a deeper tree (a
+             * hostile baked map) loses its nearest branches instead of the
+             * stack (which has room for one node's children past its end) */
+            T->sp = T->sp + m - 1u < PACKET_STACK ? T->sp + m - 1u : PACKET_STACK;
+            if (interleaved) T->staged = 0;
             goto next;
         }
     } else if (interleaved && !T->staged) {
@@ -814,7 +818,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
          * the entry distances of its lanes from below, P.tmax their tmax
          * from above) */
     } while (T->P.usable && T->stack[T->sp].tmin > T->P.tmax * RC__SLAB_FAR_SCALE);
-    T->staged = 0;
+    if (interleaved) T->staged = 0;
     T->child = T->stack[T->sp].child;
     T->count = T->stack[T->sp].count;
     T->mask = T->stack[T->sp].mask;
