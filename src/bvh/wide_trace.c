@@ -62,19 +62,19 @@ static RC__FORCE_INLINE uint32_t wide_box_test(const rc__wnode *n, const wide_ra
     return rc__wide_box_test(n, w->near_row, w->org, w->inv, tmax, tn);
 }
 
-/* Adds child c of n to e[0..m), kept nearest first; returns m + 1. */
-static RC__FORCE_INLINE uint32_t add_sorted(wide_entry e[4], uint32_t m, const rc__wnode *n, uint32_t c,
+/* Adds child c of n to e[0..m), kept in stack order: farthest first, so
+ * the nearest is on top and visited next (of equal ones the earlier);
+ * returns m + 1. */
+static RC__FORCE_INLINE uint32_t add_sorted(wide_entry *e, uint32_t m, const rc__wnode *n, uint32_t c,
                                             const float tn[4])
 {
+    wide_entry x;
     uint32_t i;
-    e[m].child = n->child[c];
-    e[m].count = n->count[c];
-    e[m].tnear = tn[c];
-    for (i = m; i > 0 && e[i].tnear < e[i - 1].tnear; --i) {
-        const wide_entry t = e[i];
-        e[i] = e[i - 1];
-        e[i - 1] = t;
-    }
+    x.child = n->child[c];
+    x.count = n->count[c];
+    x.tnear = tn[c];
+    for (i = m; i > 0 && e[i - 1].tnear <= x.tnear; --i) e[i] = e[i - 1];
+    e[i] = x;
     return m + 1;
 }
 
@@ -89,7 +89,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
     const size_t stride = mesh->stride;
     const rc__ray r = *ray;
     wide_ray w;
-    wide_entry stack[STACK_SIZE];
+    wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
     uint32_t sp = 0, child = 0, count = 0;
     float tcur = tmax;
     int found = 0;
@@ -111,22 +111,22 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                     continue;
                 }
                 {
-                    /* two to four met: sort by entry distance, push all but
-                     * the nearest farthest-first, visit the nearest */
-                    wide_entry e[4];
-                    uint32_t m = add_sorted(e, 0, n, c, tn), j;
+                    /* two to four met: sorted by entry distance straight
+                     * onto the stack, farthest first; the nearest, on top,
+                     * is visited next */
+                    wide_entry *const e = stack + sp;
+                    uint32_t m = add_sorted(e, 0, n, c, tn);
                     while (mask) {
                         c = lowest_bit(mask);
                         mask &= mask - 1u;
                         m = add_sorted(e, m, n, c, tn);
                     }
-                    for (j = m; j-- > 1;) {
-                        /* the builder caps depth so this always holds; a
-                         * corrupt tree loses branches instead of the stack */
-                        if (RC__LIKELY(sp < STACK_SIZE)) stack[sp++] = e[j];
-                    }
-                    child = e[0].child;
-                    count = e[0].count;
+                    child = e[m - 1].child;
+                    count = e[m - 1].count;
+                    /* the builder caps depth so the pushes fit; a corrupt
+                     * tree loses its nearest branches instead of the stack
+                     * (which has room for one node's children past its end) */
+                    sp = sp + m - 1u < STACK_SIZE ? sp + m - 1u : STACK_SIZE;
                     continue;
                 }
             }
@@ -207,7 +207,7 @@ typedef struct ray_turns {
     float tcur;
     uint32_t sp, child, count, staged;
     int found, settling;
-    wide_entry stack[STACK_SIZE];
+    wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
 } ray_turns;
 
 static void turns_start(ray_turns *T, const rc__ray *ray, rc__hit *hit)
@@ -232,17 +232,16 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
         float tn[4] RC__ALIGN16;
         uint32_t mask = wide_box_test(n, &T->w, T->tcur, tn);
         if (mask) {
-            wide_entry e[4];
-            uint32_t m = 0, j;
+            wide_entry *const e = T->stack + T->sp; /* as wide_traverse: sorted onto the stack */
+            uint32_t m = 0;
             while (mask) {
                 const uint32_t c = lowest_bit(mask);
                 mask &= mask - 1u;
                 m = add_sorted(e, m, n, c, tn);
             }
-            for (j = m; j-- > 1;)
-                if (RC__LIKELY(T->sp < STACK_SIZE)) T->stack[T->sp++] = e[j];
-            T->child = e[0].child;
-            T->count = e[0].count;
+            T->child = e[m - 1].child;
+            T->count = e[m - 1].count;
+            T->sp = T->sp + m - 1u < STACK_SIZE ? T->sp + m - 1u : STACK_SIZE;
             T->staged = 0;
             rc__prefetch_next(mesh->wide, mesh->leaf_tris, T->child, T->count);
             return 1;
