@@ -30,12 +30,20 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, c
                                                    uint32_t first, uint32_t count, const float *v[4][3])
 {
     uint32_t i;
-    if (count > 4u) count = 4u;
+    const uint32_t *tri = leaf_tris + (size_t)3 * first;
+    if (count >= 4u) {
+        /* every leaf but one holds four (the builder fills them): no loop */
+        for (i = 0; i < 4u; ++i) {
+            v[i][0] = vertices + tri[3u * i] * stride;
+            v[i][1] = vertices + tri[3u * i + 1u] * stride;
+            v[i][2] = vertices + tri[3u * i + 2u] * stride;
+        }
+        return 4u;
+    }
     for (i = 0; i < count; ++i) {
-        const uint32_t *tri = leaf_tris + (size_t)3 * (first + i);
-        v[i][0] = vertices + tri[0] * stride;
-        v[i][1] = vertices + tri[1] * stride;
-        v[i][2] = vertices + tri[2] * stride;
+        v[i][0] = vertices + tri[3u * i] * stride;
+        v[i][1] = vertices + tri[3u * i + 1u] * stride;
+        v[i][2] = vertices + tri[3u * i + 2u] * stride;
     }
     return count;
 }
