@@ -771,7 +771,13 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
          * nothing left */
         if (!(m & (m - 1u))) {
             const uint32_t lane = lowest_lane(m);
-            rc__leaf4_test(&rays[lane], (const float *const(*)[3])vt, n_tri, &lo);
+#if defined(RC__PACKET_AVX2)
+            /* four triangles (nearly every leaf) as a constant: no selects for missing slots */
+            if (n_tri == 4u)
+                rc__leaf4_test(&rays[lane], (const float *const(*)[3])vt, 4u, &lo);
+            else
+#endif
+                rc__leaf4_test(&rays[lane], (const float *const(*)[3])vt, n_tri, &lo);
             leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, &shrunk);
             m = 0;
         } else
