@@ -744,7 +744,8 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             /* the builder caps depth so the pushes fit; a deeper tree (a
              * hostile baked map) loses its nearest branches instead of the
              * stack (which has room for one node's children past its end) */
-            T->sp = T->sp + m - 1u < PACKET_STACK ? T->sp + m - 1u : PACKET_STACK;
+            T->sp += m - 1u;
+            if (RC__UNLIKELY(T->sp > PACKET_STACK)) T->sp = PACKET_STACK;
             if (interleaved) T->staged = 0;
             goto next;
         }

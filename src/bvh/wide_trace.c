@@ -126,7 +126,8 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                     /* the builder caps depth so the pushes fit; a corrupt
                      * tree loses its nearest branches instead of the stack
                      * (which has room for one node's children past its end) */
-                    sp = sp + m - 1u < STACK_SIZE ? sp + m - 1u : STACK_SIZE;
+                    sp += m - 1u;
+                    if (RC__UNLIKELY(sp > STACK_SIZE)) sp = STACK_SIZE;
                     continue;
                 }
             }
@@ -241,7 +242,8 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
             }
             T->child = e[m - 1].child;
             T->count = e[m - 1].count;
-            T->sp = T->sp + m - 1u < STACK_SIZE ? T->sp + m - 1u : STACK_SIZE;
+            T->sp += m - 1u;
+            if (RC__UNLIKELY(T->sp > STACK_SIZE)) T->sp = STACK_SIZE;
             T->staged = 0;
             rc__prefetch_next(mesh->wide, mesh->leaf_tris, T->child, T->count);
             return 1;
