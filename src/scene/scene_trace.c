@@ -235,13 +235,13 @@ typedef struct hit_group {
 static RC__FORCE_INLINE void group_fill(const rc_scene *scene, const rc__hit *hits, const uint32_t *at, uint32_t count,
                                         const float *directions, const uint32_t *idx, hit_group *g)
 {
-    const rc__mesh *one = &scene->geoms[0].mesh;
+    const rc__mesh *one = scene->geom_count == 1 ? &scene->geoms[0].mesh : NULL;
     uint32_t i, slots = 1;
     for (i = 0; i < count; ++i) {
         g->dir[i] = directions + (size_t)idx[at[i]] * 3u;
         slots &= hits[at[i]].slot != RC_INVALID_ID;
     }
-    if (scene->geom_count == 1 && one->leaf_tris && slots) {
+    if (one && one->leaf_tris && slots) {
         /* one own mesh, every hit with its leaf slot (the built-in
          * backend's map): the mesh's fields read once, not once a hit */
         const float *vertices = one->vertices;
