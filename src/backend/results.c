@@ -123,16 +123,25 @@ void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_
     double td[RC__PACKET_SIZE];
     uint32_t i;
     rc__scene_hit_distances_d(job->scene, hits, found, n, world, directions, idx, td);
-    if (!(job->attributes & ~(uint32_t)(RC_ATTR_HITS | RC_ATTR_RANGES))) {
-        /* ranges and hits only (a localisation filter's call): without
-         * write_refined's tests of the other attributes a ray */
-        uint8_t *const hit_out = job->attributes & RC_ATTR_HITS ? job->out->hits : NULL;
-        float *const range_out = job->attributes & RC_ATTR_RANGES ? job->out->ranges : NULL;
+    if (!(job->attributes & (RC_ATTR_POINTS | RC_ATTR_NORMALS))) {
+        /* hits, ranges and ids (a localisation filter's call): without
+         * write_refined's tests of every attribute a ray */
+        const uint32_t attr = job->attributes;
+        const rc_results *out = job->out;
+        uint8_t *const hit_out = attr & RC_ATTR_HITS ? out->hits : NULL;
+        float *const range_out = attr & RC_ATTR_RANGES ? out->ranges : NULL;
+        uint32_t *const prim_out = attr & RC_ATTR_PRIM_IDS ? out->prim_ids : NULL;
+        uint32_t *const geom_out = attr & RC_ATTR_GEOM_IDS ? out->geom_ids : NULL;
+        uint32_t *const inst_out = attr & RC_ATTR_INST_IDS ? out->inst_ids : NULL;
         for (i = 0; i < n; ++i) {
+            const uint64_t k = base + idx[i];
             int valid;
             const float range = refined_range(job->sensor, found[i], &hits[i], td[i], &valid);
-            if (hit_out) hit_out[base + idx[i]] = (uint8_t)valid;
-            if (range_out) range_out[base + idx[i]] = range;
+            if (hit_out) hit_out[k] = (uint8_t)valid;
+            if (range_out) range_out[k] = range;
+            if (prim_out) prim_out[k] = valid ? hits[i].prim : RC_INVALID_ID;
+            if (geom_out) geom_out[k] = valid ? hits[i].geom : RC_INVALID_ID;
+            if (inst_out) inst_out[k] = valid ? hits[i].inst : RC_INVALID_ID;
         }
         return;
     }
