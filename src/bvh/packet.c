@@ -317,7 +317,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
     /* each lane's four answers as lane masks, ANDed with the lane's bit and
      * ORed: met[c] in lane c of one register (bits moved one by one into
      * four words were a quarter of these visits' instructions) */
-    __m128i metv = _mm_loadu_si128((const __m128i *)met);
+    __m128i metv = _mm_loadu_si128((const __m128i *)(const void *)met);
     __m128 near = _mm_set1_ps(INFINITY); /* entry distances are never NaN: min(tl, inf) = tl */
     while (mask) {
         const uint32_t lane = lowest_lane(mask);
@@ -332,7 +332,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
         near = _mm_min_ps(_mm_load_ps(tl), near);
     }
     _mm_store_ps(tn, near);
-    _mm_storeu_si128((__m128i *)met, metv);
+    _mm_storeu_si128((__m128i *)(void *)met, metv);
     return (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(metv, _mm_setzero_si128()))) ^ 0xFu;
 #else
     uint64_t lo = 0, hi = 0; /* bits 32c + lane (lo: children 0, 1; hi: 2, 3): lane meets child c */

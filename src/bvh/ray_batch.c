@@ -78,10 +78,10 @@ typedef char rc__ray_rows_check[(offsetof(rc__ray, dir) == 12 && offsetof(rc__ra
 static RC__FORCE_INLINE void store_four(__m128 a, __m128 b, __m128 c, __m128 d, rc__ray *rays, size_t offset)
 {
     _MM_TRANSPOSE4_PS(a, b, c, d);
-    _mm_storeu_ps((float *)((char *)&rays[0] + offset), a);
-    _mm_storeu_ps((float *)((char *)&rays[1] + offset), b);
-    _mm_storeu_ps((float *)((char *)&rays[2] + offset), c);
-    _mm_storeu_ps((float *)((char *)&rays[3] + offset), d);
+    _mm_storeu_ps((float *)(void *)((char *)&rays[0] + offset), a);
+    _mm_storeu_ps((float *)(void *)((char *)&rays[1] + offset), b);
+    _mm_storeu_ps((float *)(void *)((char *)&rays[2] + offset), c);
+    _mm_storeu_ps((float *)(void *)((char *)&rays[3] + offset), d);
 }
 
 /* A ray's rows from lane values: origin, then the four rows store_four
