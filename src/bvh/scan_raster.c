@@ -1,0 +1,532 @@
+/* Projected scans (scan_raster.h): each triangle of a small mesh meets only
+ * the rays of a spherical scan that its bounding cone covers. */
+#include "bvh/scan_raster.h"
+
+#include "bvh/intersect.h"
+#include "bvh/leaf4.h" /* rc__leaf4_have_avx2 */
+
+#include <math.h>
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+#include <string.h>
+
+#define RC__TWO_PI 6.283185307179586
+
+/* Angular slack added to every cone (radians): the float rays (the
+ * direction table, then the turn into the map frame) lie within about 1e-7
+ * of their grid angles, and the float test's hits within a few ulps of the
+ * triangle; 1e-4 is orders beyond both, and costs a scan of 0.4-degree
+ * columns about 3% more tests. The test's rounding grows with the vertices'
+ * distance against the triangle's (RC__RASTER_SPREAD_SLACK). */
+#define RC__RASTER_SLACK 1e-4
+#define RC__RASTER_SPREAD_SLACK 1e-5
+/* rays prepared at a time */
+#define RC__RASTER_CHUNK 32u
+
+/* Per-ray constants of the watertight test, one array each (the shared
+ * origin needs no copy): the shear and the axis order, kx | ky << 2 | kz << 4. */
+typedef struct raster_rays {
+    float *sx, *sy, *sz;
+    unsigned char *axes;
+} raster_rays;
+
+static size_t round16(size_t n) { return (n + 15u) & ~(size_t)15u; }
+
+size_t rc__raster_scratch_bytes(uint32_t rays)
+{
+    return 3u * round16((size_t)rays * sizeof(float)) + round16(rays);
+}
+
+static void scratch_split(void *scratch, uint32_t rays, raster_rays *rr)
+{
+    unsigned char *p = (unsigned char *)scratch;
+    const size_t fl = round16((size_t)rays * sizeof(float));
+    rr->sx = (float *)(void *)p;
+    rr->sy = (float *)(void *)(p + fl);
+    rr->sz = (float *)(void *)(p + 2u * fl);
+    rr->axes = p + 3u * fl;
+}
+
+int rc__raster_grid_ok(const rc__raster_grid *g)
+{
+    const double half_pi = 1.5707963267948966;
+    const double last = g->phi_min + (double)(g->rows - 1u) * g->phi_inc;
+    return g->rows > 0 && g->cols > 0 && g->phi_min >= -half_pi && g->phi_min <= half_pi && last >= -half_pi &&
+           last <= half_pi;
+}
+
+/* Rays [from, rays) of the scan prepared as the packets prepare them, kept
+ * as the test's constants. */
+static void rays_fill(uint32_t from, uint32_t rays, const float r[9], const float org[3], const float *dirs,
+                      const raster_rays *rr)
+{
+    uint32_t at, i;
+    for (at = from; at < rays; at += RC__RASTER_CHUNK) {
+        uint32_t idx[RC__RASTER_CHUNK];
+        rc__ray batch[RC__RASTER_CHUNK];
+        const uint32_t n = rays - at < RC__RASTER_CHUNK ? rays - at : RC__RASTER_CHUNK;
+        for (i = 0; i < n; ++i) idx[i] = at + i;
+        rc__rays_prepare_turned(r, org, dirs, idx, n, batch);
+        for (i = 0; i < n; ++i) {
+            const rc__ray *ray = &batch[i];
+            rr->sx[at + i] = ray->sx;
+            rr->sy[at + i] = ray->sy;
+            rr->sz[at + i] = ray->sz;
+            rr->axes[at + i] = (unsigned char)(ray->kx | ray->ky << 2 | ray->kz << 4);
+        }
+    }
+}
+
+/* rc__tri_intersect_any_area for a ray from the origin the vertices were
+ * taken relative to (ra = a - org ...: the same float values the test
+ * computes), its operations in its order. Returns 1 with *t on a hit, 0 on
+ * a miss, -1 where that test takes a double-precision case (a zero edge
+ * function, a t tiny against the triangle's depth): the caller runs the test
+ * itself there. */
+static RC__FORCE_INLINE int shared_origin_test(const float *ra, const float *rb, const float *rc, unsigned axes,
+                                               float sx, float sy, float sz, float *t)
+{
+    const unsigned kx = axes & 3u, ky = (axes >> 2) & 3u, kz = axes >> 4;
+    const float az = ra[kz], bz = rb[kz], cz = rc[kz];
+    const float Ax = ra[kx] - sx * az, Ay = ra[ky] - sy * az;
+    const float Bx = rb[kx] - sx * bz, By = rb[ky] - sy * bz;
+    const float Cx = rc[kx] - sx * cz, Cy = rc[ky] - sy * cz;
+    const float CxBy = Cx * By, CyBx = Cy * Bx;
+    const float AxCy = Ax * Cy, AyCx = Ay * Cx;
+    const float BxAy = Bx * Ay, ByAx = By * Ax;
+    const float U = CxBy - CyBx, V = AxCy - AyCx, W = BxAy - ByAx;
+    float det, T, tt;
+    {
+        const float lo = U < V ? (U < W ? U : W) : (V < W ? V : W);
+        const float hi = U > V ? (U > W ? U : W) : (V > W ? V : W);
+        if (lo < 0.0f && hi > 0.0f) return 0;
+    }
+    if ((CxBy == CyBx) | (AxCy == AyCx) | (BxAy == ByAx)) return -1;
+    det = U + V + W;
+    if (det == 0.0f) return 0;
+    T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
+    tt = T / det;
+    if (!(tt > 0.0f)) return 0;
+    if (tt * 1024.0f < (sz < 0.0f ? -sz : sz) * ((az < 0.0f ? -az : az) + (bz < 0.0f ? -bz : bz) +
+                                                (cz < 0.0f ? -cz : cz)))
+        return -1;
+    *t = tt;
+    return 1;
+}
+
+/* A triangle as the scan sees it: its vertices, and the same relative to
+ * the origin. */
+typedef struct raster_tri {
+    const float *v[3];
+    float rel[3][3];
+    uint32_t slot;
+} raster_tri;
+
+/* What every test of one scan shares. */
+typedef struct raster_scan {
+    const rc__mesh *mesh;
+    uint32_t geom;
+    const rc__raster_grid *g;
+    raster_rays rr;
+    const float *r, *org, *dirs;
+    double tmax;
+    rc__hit *hits;
+    int *found;
+} raster_scan;
+
+/* The ray's full test, for the double-precision cases. */
+RC__COLD int full_test(const raster_tri *tri, const raster_scan *sc, uint32_t ray, float *t)
+{
+    rc__ray full;
+    float u, v;
+    rc__rays_prepare_turned(sc->r, sc->org, sc->dirs, &ray, 1u, &full);
+    return rc__tri_intersect_any_area(&full, tri->v[0], tri->v[1], tri->v[2], t, &u, &v);
+}
+
+/* The triangle's test of ray i, and its offer. */
+static RC__FORCE_INLINE void test_ray(const raster_tri *tri, const raster_scan *sc, uint32_t i)
+{
+    float t;
+    int got = shared_origin_test(tri->rel[0], tri->rel[1], tri->rel[2], sc->rr.axes[i], sc->rr.sx[i], sc->rr.sy[i],
+                                 sc->rr.sz[i], &t);
+    if (got < 0) got = full_test(tri, sc, i, &t);
+    if (got) sc->found[i] |= rc__hit_offer_slot(&sc->hits[i], t, sc->mesh->bvh.refs, tri->slot, sc->geom, RC_INVALID_ID);
+}
+
+#if defined(__GNUC__) && (defined(__SSE2__) || defined(__aarch64__)) && !defined(RC__PACKET_FORCE_SCALAR)
+/* Eight rays at a time in GCC's vector extension (SSE2, AVX2 or NEON; 32-bit
+ * ARM's NEON flushes subnormals and keeps the scalar loop): the sign half
+ * of the test, whose rejections are the scalar test's own (the same
+ * operations, and only lanes without a NaN are rejected here); the rays it
+ * leaves run the scalar test. */
+#define RC__RASTER_LANES 8u
+typedef float rc__v8f __attribute__((vector_size(32)));
+typedef int32_t rc__v8i __attribute__((vector_size(32)));
+
+/* (no vector arguments or returns: outside the AVX2 build those change the
+ * calling convention, and gcc says so) */
+#define splat8(x) ((rc__v8f){(x), (x), (x), (x), (x), (x), (x), (x)})
+#define splat8i(x) ((rc__v8i){(x), (x), (x), (x), (x), (x), (x), (x)})
+
+/* Bit k: lane k of m is set (all ones). */
+static RC__FORCE_INLINE unsigned lanes_bits(const rc__v8i *mask)
+{
+#if defined(__SSE2__)
+    __m128 h[2];
+    memcpy(h, mask, sizeof h);
+    return (unsigned)(_mm_movemask_ps(h[0]) | _mm_movemask_ps(h[1]) << 4);
+#else
+    const rc__v8i w = {1, 2, 4, 8, 16, 32, 64, 128};
+    const rc__v8i m = *mask & w;
+    int32_t b[8];
+    memcpy(b, &m, sizeof b);
+    return (unsigned)((b[0] | b[1]) | (b[2] | b[3]) | ((b[4] | b[5]) | (b[6] | b[7])));
+#endif
+}
+
+/* The whole test for rays [i, i + 8), all with the axis order `axes`, in
+ * lanes: the scalar test's operations in its order, so each lane's t is
+ * its t. Bits of *hit: lanes it hits (t in tt[]); of the return: lanes
+ * the scalar test must decide (a NaN, whose rejection the lanes do not
+ * mirror; a zero edge function; a tiny t). */
+static RC__FORCE_INLINE unsigned test8(const raster_tri *tri, const raster_scan *sc, uint32_t i, unsigned axes,
+                                       unsigned *hit, float tt_out[8])
+{
+    const unsigned kx = axes & 3u, ky = (axes >> 2) & 3u, kz = axes >> 4;
+    const float *ra = tri->rel[0], *rb = tri->rel[1], *rc = tri->rel[2];
+    const rc__v8f az = splat8(ra[kz]), bz = splat8(rb[kz]), cz = splat8(rc[kz]), zero = splat8(0.0f);
+    rc__v8f sx, sy, sz;
+    memcpy(&sx, sc->rr.sx + i, sizeof sx);
+    memcpy(&sy, sc->rr.sy + i, sizeof sy);
+    memcpy(&sz, sc->rr.sz + i, sizeof sz);
+    {
+        const rc__v8f Ax = splat8(ra[kx]) - sx * az, Ay = splat8(ra[ky]) - sy * az;
+        const rc__v8f Bx = splat8(rb[kx]) - sx * bz, By = splat8(rb[ky]) - sy * bz;
+        const rc__v8f Cx = splat8(rc[kx]) - sx * cz, Cy = splat8(rc[ky]) - sy * cz;
+        const rc__v8f CxBy = Cx * By, CyBx = Cy * Bx, AxCy = Ax * Cy, AyCx = Ay * Cx, BxAy = Bx * Ay, ByAx = By * Ax;
+        const rc__v8f U = CxBy - CyBx, V = AxCy - AyCx, W = BxAy - ByAx;
+        const rc__v8i neg = (U < zero) | (V < zero) | (W < zero);
+        const rc__v8i pos = (U > zero) | (V > zero) | (W > zero);
+        const rc__v8i ordered = (U == U) & (V == V) & (W == W);
+        const rc__v8i live = ~(neg & pos) & ordered;
+        const rc__v8i zero_edge = (CxBy == CyBx) | (AxCy == AyCx) | (BxAy == ByAx);
+        const rc__v8f det = U + V + W;
+        const rc__v8f T = U * (sz * az) + V * (sz * bz) + W * (sz * cz);
+        const rc__v8f tt = T / det;
+        const rc__v8i abs_bits = splat8i(0x7FFFFFFF);
+        const rc__v8f asz = (rc__v8f)((rc__v8i)sz & abs_bits);
+        const float depth = fabsf(ra[kz]) + fabsf(rb[kz]) + fabsf(rc[kz]);
+        const rc__v8i ahead = live & ~zero_edge & (det != zero) & (tt > zero);
+        const rc__v8i tiny = tt * splat8(1024.0f) < asz * splat8(depth);
+        const rc__v8i hits = ahead & ~tiny, rare = ~ordered | (live & zero_edge) | (ahead & tiny);
+        memcpy(tt_out, &tt, sizeof tt);
+        *hit = lanes_bits(&hits);
+        return lanes_bits(&rare);
+    }
+}
+
+#define select8(m, a, b) ((rc__v8f)(((rc__v8i)(a) & (m)) | ((rc__v8i)(b) & ~(m))))
+#define select8i(m, a, b) (((a) & (m)) | ((b) & ~(m)))
+
+/* rays_fill for whole groups of eight rays in lanes: rc__ray_prepare's
+ * values (the turn as rc__rot_apply_f, the dominant axis by the same
+ * comparisons, the shear as divisions); returns the rays done. */
+static RC__FORCE_INLINE uint32_t rays_fill8(uint32_t rays, const float r[9], const float *dirs,
+                                            const raster_rays *rr)
+{
+    uint32_t at, k;
+    for (at = 0; at + RC__RASTER_LANES <= rays; at += RC__RASTER_LANES) {
+        float in[3][8];
+        rc__v8f x, y, z, dx, dy, dz, ax, ay, az, m;
+        rc__v8i is1, is2, neg, code;
+        int32_t codes[8];
+        for (k = 0; k < RC__RASTER_LANES; ++k) {
+            in[0][k] = dirs[(size_t)(at + k) * 3u];
+            in[1][k] = dirs[(size_t)(at + k) * 3u + 1u];
+            in[2][k] = dirs[(size_t)(at + k) * 3u + 2u];
+        }
+        memcpy(&x, in[0], sizeof x);
+        memcpy(&y, in[1], sizeof y);
+        memcpy(&z, in[2], sizeof z);
+        dx = splat8(r[0]) * x + splat8(r[1]) * y + splat8(r[2]) * z;
+        dy = splat8(r[3]) * x + splat8(r[4]) * y + splat8(r[5]) * z;
+        dz = splat8(r[6]) * x + splat8(r[7]) * y + splat8(r[8]) * z;
+        ax = (rc__v8f)((rc__v8i)dx & splat8i(0x7FFFFFFF));
+        ay = (rc__v8f)((rc__v8i)dy & splat8i(0x7FFFFFFF));
+        az = (rc__v8f)((rc__v8i)dz & splat8i(0x7FFFFFFF));
+        is1 = ay > ax;
+        m = select8(is1, ay, ax);
+        is2 = az > m;
+        {
+            /* kz = 0: (kx, ky) = (y, z); 1: (z, x); 2: (x, y); swapped where
+             * the kz component is negative */
+            const rc__v8f dkz = select8(is2, dz, select8(is1, dy, dx));
+            const rc__v8f dkx0 = select8(is2, dx, select8(is1, dz, dy));
+            const rc__v8f dky0 = select8(is2, dy, select8(is1, dx, dz));
+            rc__v8f sx, sy, sz;
+            neg = dkz < splat8(0.0f);
+            sx = select8(neg, dky0, dkx0) / dkz;
+            sy = select8(neg, dkx0, dky0) / dkz;
+            sz = splat8(1.0f) / dkz;
+            memcpy(rr->sx + at, &sx, sizeof sx);
+            memcpy(rr->sy + at, &sy, sizeof sy);
+            memcpy(rr->sz + at, &sz, sizeof sz);
+        }
+        /* kx | ky << 2 | kz << 4 */
+        code = select8i(is2, select8i(neg, splat8i(33), splat8i(36)),
+                        select8i(is1, select8i(neg, splat8i(24), splat8i(18)), select8i(neg, splat8i(6), splat8i(9))));
+        memcpy(codes, &code, sizeof codes);
+        for (k = 0; k < RC__RASTER_LANES; ++k) rr->axes[at + k] = (unsigned char)codes[k];
+    }
+    return at;
+}
+
+/* Rays [first, first + n): eight at a time where their axis orders agree. */
+static RC__FORCE_INLINE void test_run(const raster_tri *tri, const raster_scan *sc, uint32_t first, uint32_t n)
+{
+    const uint32_t rays = sc->g->rows * sc->g->cols;
+    const uint32_t whole = (n + RC__RASTER_LANES - 1u) / RC__RASTER_LANES * RC__RASTER_LANES;
+    /* a run's last rays in a whole group of lanes: testing a ray the cone
+     * does not cover costs nothing but the test */
+    const uint32_t end = first + (first + whole <= rays ? whole : n);
+    uint32_t i = first;
+    for (; i + RC__RASTER_LANES <= end; i += RC__RASTER_LANES) {
+        const unsigned char *ax = sc->rr.axes + i;
+        uint64_t eight, same;
+        memcpy(&eight, ax, sizeof eight);
+        same = (uint64_t)ax[0] * 0x0101010101010101ull;
+        if (eight == same) {
+            float tt[8];
+            unsigned hit, rare = test8(tri, sc, i, ax[0], &hit, tt);
+            while (hit) {
+                const unsigned k = (unsigned)__builtin_ctz(hit);
+                hit &= hit - 1u;
+                sc->found[i + k] |=
+                    rc__hit_offer_slot(&sc->hits[i + k], tt[k], sc->mesh->bvh.refs, tri->slot, sc->geom, RC_INVALID_ID);
+            }
+            while (rare) {
+                const unsigned k = (unsigned)__builtin_ctz(rare);
+                rare &= rare - 1u;
+                test_ray(tri, sc, i + k);
+            }
+        } else {
+            uint32_t k;
+            for (k = 0; k < RC__RASTER_LANES; ++k) test_ray(tri, sc, i + k);
+        }
+    }
+    for (; i < end; ++i) test_ray(tri, sc, i);
+}
+#else
+static RC__FORCE_INLINE void test_run(const raster_tri *tri, const raster_scan *sc, uint32_t first, uint32_t n)
+{
+    uint32_t i;
+    for (i = first; i < first + n; ++i) test_ray(tri, sc, i);
+}
+#endif
+
+/* The indices k of values base + k * inc (k < count) within [lo, hi]:
+ * [*k0, *k1], empty when *k0 > *k1. */
+static void index_range(double base, double inc, uint32_t count, double lo, double hi, int64_t *k0, int64_t *k1)
+{
+    double a, b;
+    if (inc == 0.0) {
+        const int in = base >= lo && base <= hi;
+        *k0 = 0;
+        *k1 = in ? 0 : -1;
+        return;
+    }
+    a = (lo - base) / inc;
+    b = (hi - base) / inc;
+    if (a > b) {
+        const double s = a;
+        a = b;
+        b = s;
+    }
+    a = ceil(a);
+    b = floor(b);
+    *k0 = a < 0.0 ? 0 : (int64_t)a;
+    *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
+    if (b < 0.0 || a > (double)count - 1.0) *k1 = *k0 - 1;
+}
+
+/* The rays of row `row` whose azimuths lie within [lo, hi] up to whole
+ * turns (hi - lo < 2 pi), tested run by run. */
+static RC__FORCE_INLINE void test_row(const raster_tri *tri, const raster_scan *sc, uint32_t row, double lo, double hi)
+{
+    const rc__raster_grid *g = sc->g;
+    const double last = g->theta_min + (double)(g->cols - 1u) * g->theta_inc;
+    const double tlo = last < g->theta_min ? last : g->theta_min, thi = last < g->theta_min ? g->theta_min : last;
+    const double k_first = ceil((tlo - hi) / RC__TWO_PI), k_last = floor((thi - lo) / RC__TWO_PI);
+    double k;
+    for (k = k_first; k <= k_last; k += 1.0) {
+        int64_t j0, j1;
+        index_range(g->theta_min, g->theta_inc, g->cols, lo + k * RC__TWO_PI, hi + k * RC__TWO_PI, &j0, &j1);
+        if (j0 <= j1) test_run(tri, sc, row * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+    }
+}
+
+/* Every ray of the scan. */
+static void raster_rows_all(const raster_tri *tri, const raster_scan *sc)
+{
+    uint32_t i;
+    for (i = 0; i < sc->g->rows; ++i) test_run(tri, sc, i * sc->g->cols, sc->g->cols);
+}
+
+/* The azimuths the triangle spans in the sensor frame, widened by slack:
+ * [*lo, *hi]. 0 when it may hold a pole (the z axis, either way), where
+ * every azimuth is. A great circle not through a pole crosses each meridian
+ * once, so an edge's azimuths run the short way between its ends' and a
+ * triangle clear of the poles spans the shortest arc holding its corners'
+ * (the complement of the widest gap between them). */
+static int azimuths(const raster_tri *tri, const raster_scan *sc, double slack, double *lo, double *hi)
+{
+    const float *r = sc->r;
+    double p[3][2], th[3], w[3], scale = 0.0, gap, t;
+    int c, k, widest;
+    for (c = 0; c < 3; ++c) {
+        const float *v = tri->rel[c];
+        for (k = 0; k < 2; ++k) p[c][k] = (double)r[k] * v[0] + (double)r[3 + k] * v[1] + (double)r[6 + k] * v[2];
+        scale += p[c][0] * p[c][0] + p[c][1] * p[c][1];
+    }
+    /* the z axis meets the triangle's cone unless its edges' planes put it
+     * on both sides (by more than rounding) */
+    for (c = 0; c < 3; ++c) {
+        const double *a = p[c], *b = p[c == 2 ? 0 : c + 1];
+        w[c] = a[0] * b[1] - a[1] * b[0];
+    }
+    scale *= 1e-9;
+    {
+        const double wmax = w[0] > w[1] ? (w[0] > w[2] ? w[0] : w[2]) : (w[1] > w[2] ? w[1] : w[2]);
+        const double wmin = w[0] < w[1] ? (w[0] < w[2] ? w[0] : w[2]) : (w[1] < w[2] ? w[1] : w[2]);
+        if (!(wmax > scale && wmin < -scale) || !(slack < 0.5)) return 0;
+    }
+    for (c = 0; c < 3; ++c) th[c] = atan2(p[c][1], p[c][0]);
+    /* sorted, then the widest of the three gaps (the last wraps) */
+    if (th[0] > th[1]) t = th[0], th[0] = th[1], th[1] = t;
+    if (th[1] > th[2]) t = th[1], th[1] = th[2], th[2] = t;
+    if (th[0] > th[1]) t = th[0], th[0] = th[1], th[1] = t;
+    widest = 2;
+    gap = th[0] + RC__TWO_PI - th[2];
+    if (th[1] - th[0] > gap) widest = 0, gap = th[1] - th[0];
+    if (th[2] - th[1] > gap) widest = 1;
+    /* the arc starts after the widest gap and ends before it */
+    *lo = th[widest == 2 ? 0 : widest + 1] - slack;
+    *hi = th[widest] + (widest == 2 ? 0.0 : RC__TWO_PI) + slack;
+    return *hi - *lo < RC__TWO_PI;
+}
+
+/* The triangle's bounding cone from the origin, in the sensor frame, and
+ * the rays it covers. */
+static RC__FORCE_INLINE void raster_triangle(const raster_tri *tri, const raster_scan *sc)
+{
+    const double half_pi = 1.5707963267948966;
+    const rc__raster_grid *g = sc->g;
+    const float *r = sc->r;
+    double m[3], u[3], r2 = 0.0, far2 = 0.0, rad, d, rho, slack, alpha, phi_c, lo, hi, tlo, thi;
+    int64_t i0, i1, i;
+    int k;
+    for (k = 0; k < 3; ++k) m[k] = ((double)tri->rel[0][k] + tri->rel[1][k] + tri->rel[2][k]) / 3.0;
+    for (k = 0; k < 3; ++k) {
+        const double dx = tri->rel[k][0] - m[0], dy = tri->rel[k][1] - m[1], dz = tri->rel[k][2] - m[2];
+        const double e2 = dx * dx + dy * dy + dz * dz;
+        const double f2 = (double)tri->rel[k][0] * tri->rel[k][0] + (double)tri->rel[k][1] * tri->rel[k][1] +
+                          (double)tri->rel[k][2] * tri->rel[k][2];
+        if (e2 > r2) r2 = e2;
+        if (f2 > far2) far2 = f2;
+    }
+    rad = sqrt(r2) * (1.0 + 1e-9);
+    /* the sensor frame: the turn's transpose */
+    for (k = 0; k < 3; ++k) u[k] = r[k] * m[0] + r[3 + k] * m[1] + r[6 + k] * m[2];
+    d = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    /* wholly beyond the range (t counts |dir|, within 1e-6 of 1) */
+    if ((d - rad) * (1.0 - 1e-5) > sc->tmax) return;
+    rho = sqrt(u[0] * u[0] + u[1] * u[1]);
+    if (d <= rad * (1.0 + 1e-6)) {
+        raster_rows_all(tri, sc); /* the origin is in the sphere */
+        return;
+    }
+    slack = RC__RASTER_SLACK + RC__RASTER_SPREAD_SLACK * sqrt(far2) / (d - rad);
+    alpha = asin(rad / d) + slack;
+    phi_c = atan2(u[2], rho);
+    lo = phi_c - alpha;
+    hi = phi_c + alpha;
+    index_range(g->phi_min, g->phi_inc, g->rows, lo, hi, &i0, &i1);
+    if (i0 > i1) return;
+    if (lo <= -half_pi || hi >= half_pi || !azimuths(tri, sc, slack / cos(lo < -hi ? lo : hi), &tlo, &thi)) {
+        /* a pole in the cone or in the triangle: whole rows */
+        for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols, g->cols);
+    } else {
+        for (i = i0; i <= i1; ++i) test_row(tri, sc, (uint32_t)i, tlo, thi);
+    }
+}
+
+/* The scan's rays, then every triangle of the mesh (slot order) through
+ * them. */
+static RC__FORCE_INLINE void raster_all(const raster_scan *sc)
+{
+    const rc__mesh *mesh = sc->mesh;
+    const uint32_t slots = mesh->bvh.item_count;
+    const uint32_t *tris = mesh->leaf_tris;
+    const float *verts = mesh->vertices;
+    const size_t stride = mesh->stride;
+    const uint32_t rays = sc->g->rows * sc->g->cols;
+    uint32_t s;
+#if defined(RC__RASTER_LANES)
+    rays_fill(rays_fill8(rays, sc->r, sc->dirs, &sc->rr), rays, sc->r, sc->org, sc->dirs, &sc->rr);
+#else
+    rays_fill(0u, rays, sc->r, sc->org, sc->dirs, &sc->rr);
+#endif
+    for (s = 0; s < slots; ++s) {
+        const uint32_t *ix = tris + (size_t)s * 3u;
+        raster_tri tri;
+        int k, c;
+        /* a folded flat (a, a, a), or any such triple: never hit */
+        if (ix[0] == ix[1] && ix[1] == ix[2]) continue;
+        for (c = 0; c < 3; ++c) {
+            tri.v[c] = verts + (size_t)ix[c] * stride;
+            for (k = 0; k < 3; ++k) tri.rel[c][k] = tri.v[c][k] - sc->org[k];
+        }
+        tri.slot = s;
+        /* zero area: never hit (the tests skip what a commit folded) */
+        if (!mesh->flats_folded && rc__tri_zero_area(tri.v[0], tri.v[1], tri.v[2])) continue;
+        raster_triangle(&tri, sc);
+    }
+}
+
+#if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__RASTER_LANES)
+/* The same in AVX2's 256-bit lanes (no fused multiply-add: the same bits). */
+static __attribute__((target("avx2"), noinline)) void raster_all_avx2(const raster_scan *sc) { raster_all(sc); }
+#endif
+static void raster_all_base(const raster_scan *sc) { raster_all(sc); }
+
+void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const float r[9],
+                     const float org[3], const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found)
+{
+    const uint32_t rays = g->rows * g->cols;
+    raster_scan sc;
+    uint32_t i;
+    sc.mesh = mesh;
+    sc.geom = geom;
+    sc.g = g;
+    scratch_split(scratch, rays, &sc.rr);
+    sc.r = r;
+    sc.org = org;
+    sc.dirs = dirs;
+    sc.tmax = (double)tmax;
+    sc.hits = hits;
+    sc.found = found;
+    for (i = 0; i < rays; ++i) {
+        hits[i].t = tmax;
+        hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
+        found[i] = 0;
+    }
+#if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__RASTER_LANES)
+    if (rc__leaf4_have_avx2())
+        raster_all_avx2(&sc);
+    else
+#endif
+        raster_all_base(&sc);
+    for (i = 0; i < rays; ++i)
+        if (found[i]) rc__hit_settle(&hits[i], mesh->bvh.refs);
+}

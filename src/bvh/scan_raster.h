@@ -1,0 +1,47 @@
+/* Projected scans: a spherical scan of a small mesh traced triangle by
+ * triangle instead of ray by ray. Each triangle's bounding sphere, seen from
+ * the sensor, covers a cone; the rows and columns of the scan's grid that can
+ * fall in that cone are found from the grid's angles, and only those rays run
+ * the watertight test against the triangle. No tree is walked, so on a mesh
+ * with far fewer triangles than the scan has rays this costs a few tests a
+ * ray where the packets pay their node visits (docs/architecture.md,
+ * "Projected scans"). The cone is widened beyond every rounding of the
+ * test, and each test is rc__tri_intersect_any_area's operations in its
+ * order (its rare cases run that function itself), so every ray gets the
+ * nearest hit, tie rule included, that any traversal of the tree gives: the
+ * same bits. */
+#ifndef RC_BVH_SCAN_RASTER_H
+#define RC_BVH_SCAN_RASTER_H
+
+#include "bvh/mesh.h"
+
+#include <stddef.h>
+#include <stdint.h>
+
+/* A spherical grid: ray (row i, column j) points along phi_min + i * phi_inc
+ * (elevation) and theta_min + j * theta_inc (azimuth), x forward, z up. */
+typedef struct rc__raster_grid {
+    uint32_t rows, cols;
+    double phi_min, phi_inc;
+    double theta_min, theta_inc;
+} rc__raster_grid;
+
+/* 1 when every row's elevation lies within [-pi/2, pi/2] (the cone's rows
+ * are then found from the sines of the elevations). */
+int rc__raster_grid_ok(const rc__raster_grid *g);
+
+/* Scratch bytes rc__raster_scan needs for a scan of `rays` rays (16-byte
+ * multiples). */
+size_t rc__raster_scratch_bytes(uint32_t rays);
+
+/* Nearest hits of every ray of one scan on mesh (geometry id geom, no
+ * instance): hits[i] and found[i] for ray i = row * cols + column, as
+ * rc__mesh_intersect gives them from hits reset to (tmax, no id) (prims
+ * settled). r (row-major, sensor to map) and org turn the sensor's unit
+ * directions dirs (scan order) into the map frame as the packets'
+ * rc__rays_prepare_turned does. scratch: rc__raster_scratch_bytes(rays),
+ * 16-byte aligned. */
+void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const float r[9],
+                     const float org[3], const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found);
+
+#endif
