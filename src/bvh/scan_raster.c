@@ -374,34 +374,22 @@ static void raster_rows_all(const raster_tri *tri, const raster_scan *sc)
 }
 
 /* The azimuths the triangle spans in the sensor frame, widened by slack:
- * [*lo, *hi]. 0 when it may hold a pole (the z axis, either way), where
- * every azimuth is. A great circle not through a pole crosses each meridian
- * once, so an edge's azimuths run the short way between its ends' and a
- * triangle clear of the poles spans the shortest arc holding its corners'
- * (the complement of the widest gap between them). */
+ * [*lo, *hi]; 0 when that is every azimuth. The caller has found its cone
+ * clear of the poles, so the triangle holds neither. A great circle not
+ * through a pole crosses each meridian once, so an edge's azimuths run the
+ * short way between its ends' and the triangle spans the shortest arc that
+ * holds its corners' (the complement of the widest gap between them). */
 static int azimuths(const raster_tri *tri, const raster_scan *sc, double slack, double *lo, double *hi)
 {
     const float *r = sc->r;
-    double p[3][2], th[3], w[3], scale = 0.0, gap, t;
-    int c, k, widest;
+    double th[3], gap, t;
+    int c, widest;
     for (c = 0; c < 3; ++c) {
         const float *v = tri->rel[c];
-        for (k = 0; k < 2; ++k) p[c][k] = (double)r[k] * v[0] + (double)r[3 + k] * v[1] + (double)r[6 + k] * v[2];
-        scale += p[c][0] * p[c][0] + p[c][1] * p[c][1];
+        const double x = (double)r[0] * v[0] + (double)r[3] * v[1] + (double)r[6] * v[2];
+        const double y = (double)r[1] * v[0] + (double)r[4] * v[1] + (double)r[7] * v[2];
+        th[c] = atan2(y, x);
     }
-    /* the z axis meets the triangle's cone unless its edges' planes put it
-     * on both sides (by more than rounding) */
-    for (c = 0; c < 3; ++c) {
-        const double *a = p[c], *b = p[c == 2 ? 0 : c + 1];
-        w[c] = a[0] * b[1] - a[1] * b[0];
-    }
-    scale *= 1e-9;
-    {
-        const double wmax = w[0] > w[1] ? (w[0] > w[2] ? w[0] : w[2]) : (w[1] > w[2] ? w[1] : w[2]);
-        const double wmin = w[0] < w[1] ? (w[0] < w[2] ? w[0] : w[2]) : (w[1] < w[2] ? w[1] : w[2]);
-        if (!(wmax > scale && wmin < -scale) || !(slack < 0.5)) return 0;
-    }
-    for (c = 0; c < 3; ++c) th[c] = atan2(p[c][1], p[c][0]);
     /* sorted, then the widest of the three gaps (the last wraps) */
     if (th[0] > th[1]) t = th[0], th[0] = th[1], th[1] = t;
     if (th[1] > th[2]) t = th[1], th[1] = th[2], th[2] = t;
@@ -413,7 +401,7 @@ static int azimuths(const raster_tri *tri, const raster_scan *sc, double slack, 
     /* the arc starts after the widest gap and ends before it */
     *lo = th[widest == 2 ? 0 : widest + 1] - slack;
     *hi = th[widest] + (widest == 2 ? 0.0 : RC__TWO_PI) + slack;
-    return *hi - *lo < RC__TWO_PI;
+    return *hi - *lo < RC__TWO_PI && slack < 0.5;
 }
 
 /* The triangle's bounding cone from the origin, in the sensor frame, and
@@ -454,7 +442,7 @@ static RC__FORCE_INLINE void raster_triangle(const raster_tri *tri, const raster
     index_range(g->phi_min, g->phi_inc, g->rows, lo, hi, &i0, &i1);
     if (i0 > i1) return;
     if (lo <= -half_pi || hi >= half_pi || !azimuths(tri, sc, slack / cos(lo < -hi ? lo : hi), &tlo, &thi)) {
-        /* a pole in the cone or in the triangle: whole rows */
+        /* a pole in the cone: whole rows */
         for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols, g->cols);
     } else {
         for (i = i0; i <= i1; ++i) test_row(tri, sc, (uint32_t)i, tlo, thi);

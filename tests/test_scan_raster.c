@@ -1,0 +1,360 @@
+/* Projected scans (bvh/scan_raster.h): a spherical scan traced triangle by
+ * triangle must give every ray the hit the tree's single-ray search gives,
+ * bit for bit (t, triangle, hit or not). Checked on grids that wrap, overlap
+ * themselves (more than a turn of columns), run backwards, reach within 0.07
+ * rad of the poles, or hold one row or one column; in a coarse sphere with
+ * the sensor close to its wall (a triangle's bounding sphere around the
+ * origin), in a box room with the ceiling across the z axis (a pole inside
+ * a triangle), with the sensor in the floor's plane and with rays through
+ * the walls' diagonals (the test's double-precision cases), on a mesh whose
+ * zero-area triangles are left unfolded (no ray here rounds into one, so
+ * that only shows they change nothing), under turned poses and a mounting,
+ * with range limits that cut triangles off. Then through rc_simulate: every
+ * attribute of a call that takes the projected scan equals, byte for byte,
+ * a context without arena room for its scratch (the packets), on 1 and 3
+ * threads. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "backend/backend.h"
+#include "bvh/intersect.h"
+#include "bvh/scan_raster.h"
+#include "core/context.h"
+#include "rc_test.h"
+#include "scene/scene.h"
+#include "sensor/sensor.h"
+
+typedef struct grid_case {
+    float theta_min, theta_inc;
+    uint32_t cols;
+    float phi_min, phi_inc;
+    uint32_t rows;
+} grid_case;
+
+static const grid_case grids[] = {
+    {-3.14159265f, 0.00698132f, 900u, -0.261799f, 0.0349066f, 16u}, /* VLP-16 */
+    {2.0f, -0.05f, 150u, -1.5f, 0.1f, 31u},                        /* backwards, 7.5 rad, near the poles */
+    {-0.5f, 0.01f, 37u, 0.3f, 0.0f, 1u},                           /* one row, a part of a turn */
+    {2.9f, 0.0f, 1u, -0.2f, 0.07f, 7u},                            /* one column */
+    {-1.0f, 0.013f, 500u, 1.0f, -0.11f, 23u},                      /* rows downwards to -1.42 */
+};
+
+static rc_sensor *grid_sensor(rc_context *ctx, const grid_case *gc, float rmin, float rmax, const rc_pose *mount)
+{
+    rc_spherical_desc d = rc_spherical_desc_default();
+    rc_sensor *s = NULL;
+    d.common.range_min = rmin;
+    d.common.range_max = rmax;
+    if (mount) d.common.sensor_to_base = *mount;
+    d.theta.min = gc->theta_min;
+    d.theta.increment = gc->theta_inc;
+    d.theta.count = gc->cols;
+    d.phi.min = gc->phi_min;
+    d.phi.increment = gc->phi_inc;
+    d.phi.count = gc->rows;
+    RCT_OK(ctx, rc_sensor_create_spherical(ctx, &d, &s));
+    return s;
+}
+
+/* The projected scan of one pose against rc__mesh_intersect ray by ray;
+ * returns the rays that hit. */
+static uint32_t check_pose(const rc__mesh *mesh, const rc_sensor *s, const rc_pose *pose)
+{
+    rc__raster_grid g;
+    rc__xformf world;
+    const uint32_t rays = s->rays;
+    void *scratch = malloc(rc__raster_scratch_bytes(rays));
+    rc__hit *hits = malloc(rays * sizeof *hits);
+    int *found = malloc(rays * sizeof *found);
+    uint32_t i, hit_count = 0;
+    assert_true(scratch && hits && found);
+    g.rows = s->rows;
+    g.cols = s->columns;
+    g.phi_min = s->spherical.phi.min;
+    g.phi_inc = s->spherical.phi.increment;
+    g.theta_min = s->spherical.theta.min;
+    g.theta_inc = s->spherical.theta.increment;
+    assert_true(rc__raster_grid_ok(&g));
+    rc__sensor_world_xform(s, pose, &world);
+    rc__raster_scan(mesh, 0u, &g, world.r, world.t, s->directions, s->range_max, scratch, hits, found);
+    for (i = 0; i < rays; ++i) {
+        rc__ray ray;
+        rc__hit want;
+        int want_found;
+        rc__rays_prepare_turned(world.r, world.t, s->directions, &i, 1u, &ray);
+        want.t = s->range_max;
+        want.prim = want.geom = want.inst = want.slot = RC_INVALID_ID;
+        want_found = rc__mesh_intersect(mesh, &ray, 0u, RC_INVALID_ID, &want);
+        if (want_found != found[i]) fail_msg("ray %u: found %d, the tree %d", i, found[i], want_found);
+        if (!want_found) continue;
+        ++hit_count;
+        if (memcmp(&want.t, &hits[i].t, sizeof want.t) != 0 || want.prim != hits[i].prim)
+            fail_msg("ray %u: t %.9g on %u, the tree %.9g on %u", i, (double)hits[i].t, hits[i].prim, (double)want.t,
+                     want.prim);
+        assert_int_equal(hits[i].geom, 0u);
+        assert_int_equal(hits[i].inst, RC_INVALID_ID);
+    }
+    free(scratch);
+    free(hits);
+    free(found);
+    return hit_count;
+}
+
+/* Every grid at every pose; at least min_hits of all their rays hit. */
+static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_count, float rmin, float rmax,
+                       double min_hits, int unfold)
+{
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_scene *scene = rct_scene_mesh(ctx, m, RC_MESH_REFERENCE);
+    rc__mesh *mesh = &scene->geoms[0].mesh;
+    const rc_pose mount = rct_pose_ypr(0.1f, -0.05f, 0.2f, 0.3, 0.2, -0.1);
+    uint64_t rays = 0, hit = 0;
+    uint32_t k, p;
+    if (unfold) {
+        /* the tests' own triples: zero-area triangles whole, checked */
+        assert_true(mesh->flats_folded);
+        rc__mesh_unfold_flats(mesh, (uint32_t *)(uintptr_t)mesh->leaf_tris);
+        mesh->flats_folded = 0;
+    }
+    for (k = 0; k < sizeof grids / sizeof grids[0]; ++k) {
+        rc_sensor *s = grid_sensor(ctx, &grids[k], rmin, rmax, k == 4 ? &mount : NULL);
+        for (p = 0; p < pose_count; ++p) {
+            hit += check_pose(mesh, s, &poses[p]);
+            rays += s->rays;
+        }
+        rc_sensor_destroy(s);
+    }
+    if (hit < min_hits * (double)rays) fail_msg("%llu of %llu rays hit", (unsigned long long)hit, (unsigned long long)rays);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+}
+
+static void test_sphere(void **state)
+{
+    rcu_mesh m;
+    const rc_pose poses[] = {
+        rct_pose(0.0f, 0.0f, 0.0f),
+        rct_pose_ypr(4.6f, 0.3f, -0.2f, 0.7, 1.2, -0.4),   /* 0.4 m from the wall */
+        rct_pose_ypr(-1.0f, 2.0f, 0.5f, -2.0, 1.5707963, 0.0), /* pitched up: the z axis level */
+        rct_pose_ypr(0.5f, -4.2f, 1.0f, 3.1, -0.6, 2.5),
+    };
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(5.0f, 14u, 9u, &m), 0);
+    check_mesh(&m, poses, 4u, 0.0f, 100.0f, 0.999, 0);
+    rcu_mesh_free(&m);
+    /* finer, and a range that ends short of most of the wall: triangles
+     * wholly beyond it are skipped */
+    assert_int_equal(rcu_mesh_uv_sphere(5.0f, 60u, 30u, &m), 0);
+    check_mesh(&m, poses + 1, 1u, 0.0f, 4.5f, 0.2, 0);
+    rcu_mesh_free(&m);
+}
+
+/* A sensor in the floor's plane (a rounded t near 0) and the middle of a
+ * room whose walls' diagonals pass through the rays along the axes (zero
+ * edge functions): the test's double-precision cases. */
+static void test_rare_cases(void **state)
+{
+    const float lo[3] = {-4.0f, -4.0f, -1.0f}, hi[3] = {4.0f, 4.0f, 1.0f};
+    const float flo[3] = {-4.1f, -3.3f, 0.3f}, fhi[3] = {5.2f, 4.7f, 2.9f};
+    const grid_case axes = {-3.14159265f, 0.785398163f, 8u, 0.0f, 0.0f, 1u};
+    const rc_pose centre = rct_pose(0.0f, 0.0f, 0.0f);
+    const rc_pose on_floor[] = {rct_pose(0.7f, 0.2f, 0.3f), rct_pose_ypr(-1.3f, 1.1f, 0.3f, 0.4, 0.0, 0.0)};
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rcu_mesh room, floor_room;
+    rc_scene *scene;
+    rc_sensor *s;
+    uint32_t p;
+    (void)state;
+    assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
+    scene = rct_scene_mesh(ctx, &room, RC_MESH_REFERENCE);
+    s = grid_sensor(ctx, &axes, 0.0f, 50.0f, NULL);
+    assert_int_equal(check_pose(&scene->geoms[0].mesh, s, &centre), 8u);
+    rc_sensor_destroy(s);
+    rc_scene_destroy(scene);
+    assert_int_equal(rcu_mesh_box(flo, fhi, &floor_room), 0);
+    scene = rct_scene_mesh(ctx, &floor_room, RC_MESH_REFERENCE);
+    s = grid_sensor(ctx, &grids[0], 0.0f, 50.0f, NULL);
+    for (p = 0; p < 2u; ++p) assert_true(check_pose(&scene->geoms[0].mesh, s, &on_floor[p]) > s->rays / 3u);
+    rc_sensor_destroy(s);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&room);
+    rcu_mesh_free(&floor_room);
+}
+
+static void test_box_room(void **state)
+{
+    const float lo[3] = {-4.0f, -3.0f, 0.0f}, hi[3] = {5.0f, 4.0f, 2.5f};
+    rcu_mesh m;
+    const rc_pose poses[] = {
+        rct_pose(0.0f, 0.0f, 0.0f), /* in the floor's plane */
+        rct_pose(1.0f, 2.0f, 1.2f),
+        rct_pose_ypr(-3.9f, 3.9f, 2.4f, 0.4, 0.3, 0.2), /* a corner */
+        rct_pose_ypr(0.0f, 0.0f, 1.0f, 0.0, 1.5707963, 0.0),
+    };
+    (void)state;
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    check_mesh(&m, poses, 4u, 0.0f, 50.0f, 0.45, 0);
+    rcu_mesh_free(&m);
+}
+
+/* Zero-area triangles across the view, left in the triples: never hit. */
+static void test_unfolded_flats(void **state)
+{
+    const float lo[3] = {-4.0f, -3.0f, -1.0f}, hi[3] = {5.0f, 4.0f, 2.5f};
+    rcu_mesh m, flats;
+    const rc_pose poses[] = {rct_pose(0.0f, 0.0f, 0.0f), rct_pose_ypr(1.0f, -1.0f, 0.5f, 0.5, 0.2, 0.1)};
+    uint32_t i;
+    (void)state;
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    assert_int_equal(rcu_mesh_reserve(&flats, 9u, 3u), 0);
+    for (i = 0; i < 9u; ++i) {
+        /* three collinear points a triangle (exactly: small integers and
+         * halves), lines from the walls inwards */
+        const float s = (float)(i % 3u), k = (float)(i / 3u);
+        flats.vertices[3u * i] = 2.0f - k + s * (k - 1.0f);
+        flats.vertices[3u * i + 1u] = s * (1.0f - 0.5f * k);
+        flats.vertices[3u * i + 2u] = 0.5f * s;
+    }
+    for (i = 0; i < 9u; ++i) flats.indices[i] = i;
+    flats.vertex_count = 9u;
+    flats.triangle_count = 3u;
+    assert_int_equal(rcu_mesh_append(&m, &flats), 0);
+    check_mesh(&m, poses, 2u, 0.0f, 50.0f, 0.45, 1);
+    rcu_mesh_free(&flats);
+    rcu_mesh_free(&m);
+}
+
+/* enough for 3 threads to take a pose each (fewer poses than 4 a thread
+ * split scans into slices, which take the packets) */
+#define POSES 12u
+
+/* A sensor that leaves the arena about `left` bytes free. */
+static rc_sensor *fill_arena(rc_context *ctx, size_t left)
+{
+    rc_memory_stats st = rc_memory_stats_default();
+    rc_spherical_desc d = rc_spherical_desc_default();
+    rc_sensor *s = NULL;
+    size_t bytes = 0;
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &st));
+    d.common.range_max = 10.0f;
+    d.theta.increment = 1e-4f;
+    d.theta.count = 1u;
+    d.phi.count = 1u;
+    RCT_OK(ctx, rc_sensor_memory_requirements_spherical(&d, &bytes));
+    assert_true(st.arena_size > st.arena_used + left + bytes);
+    d.theta.count = (uint32_t)((st.arena_size - st.arena_used - left) / 12u);
+    do {
+        d.theta.count -= 64u;
+        RCT_OK(ctx, rc_sensor_memory_requirements_spherical(&d, &bytes));
+    } while (st.arena_used + bytes + left > st.arena_size);
+    RCT_OK(ctx, rc_sensor_create_spherical(ctx, &d, &s));
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &st));
+    assert_true(st.arena_size - st.arena_used < 2u * left);
+    return s;
+}
+
+/* Every attribute of calls with ctx (room for the projected scan's scratch)
+ * and tight (none: the packets), byte for byte. */
+static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads)
+{
+    const uint32_t attrs = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_POINTS | RC_ATTR_NORMALS | RC_ATTR_PRIM_IDS |
+                           RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS;
+    rc_pose poses[POSES];
+    rc_scene *sa = rct_scene_mesh(ctx, m, RC_MESH_REFERENCE), *sb = rct_scene_mesh(tight, m, RC_MESH_REFERENCE);
+    rc_sensor *a = NULL, *b = NULL, *filler;
+    rc_memory_stats before = rc_memory_stats_default(), after = rc_memory_stats_default();
+    rct_buffers ba, bb;
+    uint32_t p, ninf = 0, pinf = 0;
+    uint64_t i;
+    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &a));
+    RCT_OK(tight, rc_sensor_create_preset(tight, RC_PRESET_VELODYNE_VLP16, &b));
+    /* three of them within 0.2 m of a wall, the ceiling or the ball */
+    poses[0] = rct_pose_ypr(-2.0f, 1.5f, 0.0f, 0.3, -0.5, 0.0);
+    poses[1] = rct_pose_ypr(-2.8f, -1.8f, 0.1f, 1.2, 0.3, 0.1);
+    poses[2] = rct_pose_ypr(3.0f, 2.5f, 2.3f, -0.7, 0.6, -0.2);
+    poses[3] = rct_pose_ypr(0.0f, 0.0f, 1.0f, 2.5, 1.1, 0.4);
+    poses[4] = rct_pose_ypr(1.5f, 0.5f, 2.0f, -2.0, -0.2, 0.9);
+    poses[5] = rct_pose_ypr(2.0f, -1.5f, 0.5f, 0.0, -1.2, 0.0);
+    for (p = 6; p < POSES; ++p) {
+        poses[p] = poses[p - 6u];
+        poses[p].position[2] += 0.05f;
+    }
+    rct_buffers_alloc(&ba, POSES * a->rays, attrs);
+    rct_buffers_alloc(&bb, POSES * b->rays, attrs);
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &before));
+    RCT_OK(ctx, rc_simulate(ctx, sa, a, poses, POSES, &ba.res));
+    RCT_OK(ctx, rc_context_get_memory_stats(ctx, &after));
+    /* the call took the projected scan: it borrowed the scratch */
+    assert_true(before.arena_peak < before.arena_used + threads * rc__raster_scratch_bytes(a->rays));
+    assert_true(after.arena_peak >= before.arena_used + threads * rc__raster_scratch_bytes(a->rays));
+    filler = fill_arena(tight, rc__raster_scratch_bytes(b->rays) / 2u);
+    RCT_OK(tight, rc_context_get_memory_stats(tight, &before));
+    RCT_OK(tight, rc_simulate(tight, sb, b, poses, POSES, &bb.res));
+    RCT_OK(tight, rc_context_get_memory_stats(tight, &after));
+    /* this one could not: nothing borrowed */
+    assert_true(after.arena_peak == before.arena_peak);
+    assert_memory_equal(ba.res.hits, bb.res.hits, ba.n);
+    assert_memory_equal(ba.res.ranges, bb.res.ranges, ba.n * sizeof(float));
+    assert_memory_equal(ba.res.points, bb.res.points, ba.n * 3u * sizeof(float));
+    assert_memory_equal(ba.res.normals, bb.res.normals, ba.n * 3u * sizeof(float));
+    assert_memory_equal(ba.res.prim_ids, bb.res.prim_ids, ba.n * sizeof(uint32_t));
+    assert_memory_equal(ba.res.geom_ids, bb.res.geom_ids, ba.n * sizeof(uint32_t));
+    assert_memory_equal(ba.res.inst_ids, bb.res.inst_ids, ba.n * sizeof(uint32_t));
+    for (i = 0; i < ba.n; ++i) {
+        ninf += ba.res.ranges[i] < 0.0f && isinf(ba.res.ranges[i]);
+        pinf += ba.res.ranges[i] > 0.0f && isinf(ba.res.ranges[i]);
+    }
+    /* the box room of compare_simulate has both: walls nearer than
+     * range_min (0.5 m) and openings with nothing within range */
+    assert_true(ninf > 0 && pinf > 0 && ninf + pinf < ba.n / 2u);
+    rct_buffers_free(&ba);
+    rct_buffers_free(&bb);
+    rc_sensor_destroy(a);
+    rc_sensor_destroy(b);
+    rc_sensor_destroy(filler);
+    rc_scene_destroy(sa);
+    rc_scene_destroy(sb);
+}
+
+static void test_simulate(void **state)
+{
+    const float lo[3] = {-3.0f, -2.0f, -0.2f}, hi[3] = {4.0f, 3.0f, 2.5f};
+    rcu_mesh room, sphere;
+    uint32_t threads;
+    (void)state;
+    assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
+    /* the room's floor, walls and ceiling, and a ball in it; the room's
+     * corner at (-3, -2) is cut open by the ball's range of sight */
+    assert_int_equal(rcu_mesh_uv_sphere(0.8f, 24u, 12u, &sphere), 0);
+    {
+        const float at[3] = {1.5f, 0.5f, 1.0f};
+        rcu_mesh_transform(&sphere, 0.0f, at);
+    }
+    assert_int_equal(rcu_mesh_append(&room, &sphere), 0);
+    /* an opening: the box's first two triangles (a face) dropped */
+    memmove(room.indices, room.indices + 6u, (room.triangle_count - 2u) * 3u * sizeof(uint32_t));
+    room.triangle_count -= 2u;
+    for (threads = 1; threads <= 3; threads += 2) {
+        rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
+        rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
+        compare_calls(ctx, tight, &room, threads);
+        rc_context_destroy(ctx);
+        rc_context_destroy(tight);
+    }
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&room);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_sphere),
+        cmocka_unit_test(test_box_room),
+        cmocka_unit_test(test_rare_cases),
+        cmocka_unit_test(test_unfolded_flats),
+        cmocka_unit_test(test_simulate),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
