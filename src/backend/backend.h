@@ -66,6 +66,13 @@ void rc__job_world_xform(const rc__sim_job *job, uint32_t pose, rc__xformf *out)
 void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], const float *org_s,
                       int found, const rc__hit *hit, const float n_world[3], const rc__xformf *world);
 
+/* rc__write_result for rays first .. first + n - 1 of one pose of a
+ * one-origin sensor (element base + ray; no normals passed in), whose
+ * distances the caller refined already: td[i], as rc__scene_hit_distance_d
+ * gives it for hits[i] (a projected scan's). */
+void rc__write_results_run(const rc__sim_job *job, uint64_t base, uint32_t first, uint32_t n, const int *found,
+                           const rc__hit *hits, const double *td, const rc__xformf *world);
+
 #if defined(RC__HIT_DISTANCES_SSE2)
 /* rc__write_result for n rays of one pose of a one-origin sensor (a packet
  * tile, or a run of the Embree backend's batch; n <= RC__PACKET_SIZE; ray i

@@ -26,10 +26,12 @@
  * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
  * 16 +30%, 32 +13%, 64 even, 128 -18%). */
 #define RC__PACKET_MAX_MESHES 32u
-/* sim_run.large holds one bit per mesh */
 /* Projected scans (scan_raster.h) for meshes of at most one triangle per
- * this many rays of the scan. */
-#define RC__RASTER_RAYS_PER_TRIANGLE 4u
+ * this many rays of the scan: a VLP-16 scan (14,400 rays) on the sphere
+ * against the packets, callgrind, 1 thread: 1k -50%, 10k -21%, 14k -12%
+ * instructions; 100k +123% (placing every triangle costs more there). */
+#define RC__RASTER_RAYS_PER_TRIANGLE 1u
+/* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
 
 typedef struct tiling {
@@ -55,9 +57,11 @@ typedef struct sim_run {
     size_t order_scratch_stride;
     uint32_t large;                  /* bit g: mesh g is large (rc__mesh_is_large), for scenes of
                                       * up to RC__PACKET_MAX_MESHES meshes */
+#if defined(RC__PROJECTED_SCANS)
     rc__raster_grid grid;            /* projected scans: the sensor's grid */
     unsigned char *raster_scratch;   /* projected scans: raster_stride bytes per thread */
     size_t raster_stride;
+#endif
 } sim_run;
 
 /* Tile shape: RC__PACKET_SIZE rays, as close to square in angle as the sensor's grid
@@ -332,41 +336,30 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
     trace_tiles(run, recs, 0u, count, pose0, worlds);
 }
 
+#if defined(RC__PROJECTED_SCANS)
 /* Bytes of a projected scan's scratch per thread: the test's constants,
- * then every ray's hit and found flag. */
+ * then every ray's refined distance, hit and found flag. */
 static size_t raster_stride(uint32_t rays)
 {
-    return rc__raster_scratch_bytes(rays) + (((size_t)rays * (sizeof(rc__hit) + sizeof(int)) + 15u) & ~(size_t)15u);
+    return rc__raster_scratch_bytes(rays) +
+           (((size_t)rays * (sizeof(double) + sizeof(rc__hit) + sizeof(int)) + 15u) & ~(size_t)15u);
 }
 
-/* One pose of a projected scan (scan_raster.h), then its results written
- * tile by tile as the packets' are. */
+/* One pose of a projected scan (scan_raster.h), then its results. */
 static void raster_task(void *user, uint32_t pose, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
     unsigned char *scratch = run->raster_scratch + (size_t)thread * run->raster_stride;
-    rc__hit *hits = (rc__hit *)(void *)(scratch + rc__raster_scratch_bytes(sensor->rays));
+    double *td = (double *)(void *)(scratch + rc__raster_scratch_bytes(sensor->rays));
+    rc__hit *hits = (rc__hit *)(void *)(td + sensor->rays);
     int *found = (int *)(void *)(hits + sensor->rays);
-    const uint64_t base = (uint64_t)pose * sensor->rays;
     rc__xformf world;
-    uint32_t at, i;
     rc__job_world_xform(job, pose, &world);
-    rc__raster_scan(&job->scene->geoms[0].mesh, 0u, &run->grid, world.r, world.t, sensor->directions,
-                    sensor->range_max, scratch, hits, found);
-    for (at = 0; at < sensor->rays; at += RC__PACKET_SIZE) {
-        uint32_t idx[RC__PACKET_SIZE];
-        const uint32_t n = sensor->rays - at < RC__PACKET_SIZE ? sensor->rays - at : RC__PACKET_SIZE;
-        for (i = 0; i < n; ++i) idx[i] = at + i;
-#if defined(RC__HIT_DISTANCES_SSE2)
-        rc__write_results_tile(job, base, idx, n, found + at, hits + at, &world);
-#else
-        for (i = 0; i < n; ++i)
-            rc__write_result(job, base + at + i, sensor->directions + (size_t)(at + i) * 3u, NULL, found[at + i],
-                             &hits[at + i], NULL, &world);
-#endif
-    }
+    rc__raster_scan(&job->scene->geoms[0].mesh, 0u, &run->grid, &world, sensor->directions, sensor->range_max, scratch,
+                    hits, found, td);
+    rc__write_results_run(job, (uint64_t)pose * sensor->rays, 0u, sensor->rays, found, hits, td, &world);
 }
 
 /* Sets up a projected scan when it pays: a spherical sensor over a scene of
@@ -396,6 +389,8 @@ static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     run->raster_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->raster_stride * ctx->thread_count);
     return run->raster_scratch != NULL;
 }
+
+#endif
 
 /* Sets up an ordered run when it pays: an own mesh larger than the cache
  * (with instances too: a map and the objects moving in it), and enough tiles
@@ -477,7 +472,7 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
         run.slices = want < max_slices ? want : (max_slices ? max_slices : 1u);
     }
     run.tiles_per_slice = (run.tiles + run.slices - 1u) / run.slices;
-#if !defined(RANGECAST_NO_PACKETS)
+#if defined(RC__PROJECTED_SCANS) && !defined(RANGECAST_NO_PACKETS)
     if (plan_raster(ctx, job, &run)) {
         rc__pool_run(ctx->pool, job->pose_count, raster_task, &run);
         rc__arena_free(&ctx->arena, run.raster_scratch);

@@ -5,6 +5,7 @@
  * library, issue 6's size budget). */
 #include "backend/backend.h"
 #include "bvh/intersect.h" /* RC__FORCE_INLINE */
+#include "bvh/scan_raster.h" /* RC__PROJECTED_SCANS */
 #include "core/work_order.h"
 #if defined(RC__HIT_DISTANCES_SSE2)
 #include "bvh/packet.h" /* RC__PACKET_SIZE */
@@ -115,14 +116,14 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
                   found ? rc__scene_hit_distance_d(job->scene, hit, world, dir_s, org_s) : 0.0, n_world_in, world);
 }
 
-#if defined(RC__HIT_DISTANCES_SSE2)
-void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t n, const int *found,
-                            const rc__hit *hits, const rc__xformf *world)
+/* Rays idx[i] (or first + i where idx is NULL) of one pose of a one-origin
+ * sensor, element base + ray, with their refined distances td[i]. */
+static RC__FORCE_INLINE void write_rays(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t first,
+                                        uint32_t n, const int *found, const rc__hit *hits, const double *td,
+                                        const rc__xformf *world)
 {
     const float *directions = job->sensor->directions;
-    double td[RC__PACKET_SIZE];
     uint32_t i;
-    rc__scene_hit_distances_d(job->scene, hits, found, n, world, directions, idx, td);
     if (!(job->attributes & (RC_ATTR_POINTS | RC_ATTR_NORMALS))) {
         /* hits, ranges and ids (a localisation filter's call): without
          * write_refined's tests of every attribute a ray */
@@ -134,7 +135,7 @@ void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_
         uint32_t *const geom_out = attr & RC_ATTR_GEOM_IDS ? out->geom_ids : NULL;
         uint32_t *const inst_out = attr & RC_ATTR_INST_IDS ? out->inst_ids : NULL;
         for (i = 0; i < n; ++i) {
-            const uint64_t k = base + idx[i];
+            const uint64_t k = base + (idx ? idx[i] : first + i);
             int valid;
             const float range = refined_range(job->sensor, found[i], &hits[i], td[i], &valid);
             if (hit_out) hit_out[k] = (uint8_t)valid;
@@ -145,9 +146,27 @@ void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_
         }
         return;
     }
-    for (i = 0; i < n; ++i)
-        write_refined(job, base + idx[i], directions + (size_t)idx[i] * 3u, NULL, found[i], &hits[i], td[i], NULL,
-                      world);
+    for (i = 0; i < n; ++i) {
+        const uint32_t ray = idx ? idx[i] : first + i;
+        write_refined(job, base + ray, directions + (size_t)ray * 3u, NULL, found[i], &hits[i], td[i], NULL, world);
+    }
+}
+
+#if defined(RC__PROJECTED_SCANS)
+void rc__write_results_run(const rc__sim_job *job, uint64_t base, uint32_t first, uint32_t n, const int *found,
+                           const rc__hit *hits, const double *td, const rc__xformf *world)
+{
+    write_rays(job, base, NULL, first, n, found, hits, td, world);
+}
+#endif
+
+#if defined(RC__HIT_DISTANCES_SSE2)
+void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t n, const int *found,
+                            const rc__hit *hits, const rc__xformf *world)
+{
+    double td[RC__PACKET_SIZE];
+    rc__scene_hit_distances_d(job->scene, hits, found, n, world, job->sensor->directions, idx, td);
+    write_rays(job, base, idx, 0u, n, found, hits, td, world);
 }
 #endif
 

@@ -14,9 +14,17 @@
 #define RC_BVH_SCAN_RASTER_H
 
 #include "bvh/mesh.h"
+#include "core/rmath.h"
 
 #include <stddef.h>
 #include <stdint.h>
+
+/* Left out where CMake's RANGECAST_PROJECTED_SCANS is off (by default in
+ * MinSizeRel builds, as the static core for small boards is built: they take
+ * about 12 KB of text on aarch64, more than the core's size budget has left,
+ * docs/benchmarks.md). Calls then take the packets, with the same results. */
+#if !defined(RANGECAST_NO_PROJECTED_SCANS)
+#define RC__PROJECTED_SCANS 1
 
 /* A spherical grid: ray (row i, column j) points along phi_min + i * phi_inc
  * (elevation) and theta_min + j * theta_inc (azimuth), x forward, z up. */
@@ -37,11 +45,13 @@ size_t rc__raster_scratch_bytes(uint32_t rays);
 /* Nearest hits of every ray of one scan on mesh (geometry id geom, no
  * instance): hits[i] and found[i] for ray i = row * cols + column, as
  * rc__mesh_intersect gives them from hits reset to (tmax, no id) (prims
- * settled). r (row-major, sensor to map) and org turn the sensor's unit
+ * settled), and for each hit td[i], its distance refined in double as
+ * rc__scene_hit_distance_d gives it. world turns the sensor's unit
  * directions dirs (scan order) into the map frame as the packets'
- * rc__rays_prepare_turned does. scratch: rc__raster_scratch_bytes(rays),
- * 16-byte aligned. */
-void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const float r[9],
-                     const float org[3], const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found);
+ * rc__rays_prepare_turned does. scratch: rc__raster_scratch_bytes(rays). */
+void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const rc__xformf *world,
+                     const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found, double *td);
+
+#endif /* RC__PROJECTED_SCANS */
 
 #endif

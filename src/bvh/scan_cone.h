@@ -1,0 +1,156 @@
+/* Placing a bounding sphere on a spherical scan's grid (scan_raster.c): the
+ * rows its cone from the origin can reach, and the azimuths a triangle
+ * spans. Everything here errs wide: a row or column it gives too many costs
+ * a test, one it misses would lose a hit. Private to scan_raster.c. */
+#ifndef RC_BVH_SCAN_CONE_H
+#define RC_BVH_SCAN_CONE_H
+
+#include "bvh/scan_raster.h"
+
+#include <math.h>
+#include <stdint.h>
+
+#define RC__TWO_PI 6.283185307179586
+#define RC__HALF_PI 1.5707963267948966
+
+/* Angular slack added to every cone (radians): the float rays (the
+ * direction table, then the turn into the map frame) lie within about 1e-7
+ * of their grid angles, and the float test's hits within a few ulps of the
+ * triangle; 1e-4 is orders beyond both, and costs a scan of 0.4-degree
+ * columns about 3% more tests. The test's rounding grows with the vertices'
+ * distance against the triangle's (RC__CONE_SPREAD_SLACK), and the angles
+ * below are rc__cone_atan2's (RC__CONE_ATAN_ERROR). */
+#define RC__CONE_SLACK 1e-4
+#define RC__CONE_SPREAD_SLACK 1e-5
+#define RC__CONE_ATAN_ERROR 1e-9
+
+/* atan2(y, x) within RC__CONE_ATAN_ERROR, without libm's cost (at 10k
+ * triangles its calls were a fifth of a scan): folded to an argument z in
+ * [0, tan(pi / 8)], then the alternating series of atan z to its z^19
+ * term, whose error is below z^21 / 21 < 5e-10. (0, 0) gives 0. */
+static inline double rc__cone_atan2(double y, double x)
+{
+    const double ax = fabs(x), ay = fabs(y);
+    const double big = ax > ay ? ax : ay, small = ax > ay ? ay : ax;
+    double z, z2, s, a = 0.0;
+    if (big == 0.0) return 0.0;
+    z = small / big;
+    if (z > 0.41421356237309503) {
+        /* atan z = pi / 4 + atan((z - 1) / (z + 1)) */
+        z = (z - 1.0) / (z + 1.0);
+        a = 0.78539816339744831;
+    }
+    z2 = z * z;
+    s = 1.0 / 19.0;
+    s = 1.0 / 17.0 - z2 * s;
+    s = 1.0 / 15.0 - z2 * s;
+    s = 1.0 / 13.0 - z2 * s;
+    s = 1.0 / 11.0 - z2 * s;
+    s = 1.0 / 9.0 - z2 * s;
+    s = 1.0 / 7.0 - z2 * s;
+    s = 1.0 / 5.0 - z2 * s;
+    s = 1.0 / 3.0 - z2 * s;
+    s = 1.0 - z2 * s;
+    a += z * s;
+    if (ay > ax) a = RC__HALF_PI - a;
+    if (x < 0.0) a = 3.141592653589793 - a;
+    return y < 0.0 ? -a : a;
+}
+
+/* The indices k of values base + k * inc (k < count) within [lo, hi]:
+ * [*k0, *k1], empty when *k0 > *k1. */
+static inline void rc__cone_index_range(double base, double inc, uint32_t count, double lo, double hi, int64_t *k0,
+                                        int64_t *k1)
+{
+    double a, b;
+    if (inc == 0.0) {
+        const int in = base >= lo && base <= hi;
+        *k0 = 0;
+        *k1 = in ? 0 : -1;
+        return;
+    }
+    a = (lo - base) / inc;
+    b = (hi - base) / inc;
+    if (a > b) {
+        const double s = a;
+        a = b;
+        b = s;
+    }
+    a = ceil(a);
+    b = floor(b);
+    *k0 = a < 0.0 ? 0 : (int64_t)a;
+    *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
+    if (b < 0.0 || a > (double)count - 1.0) *k1 = *k0 - 1;
+}
+
+/* Where a sphere's cone falls on the grid. */
+typedef struct rc__cone {
+    double lo, hi;  /* its elevations (radians, slack included) */
+    double slack;   /* the slack an azimuth takes at elevation 0 */
+    int64_t i0, i1; /* the rows within [lo, hi] */
+} rc__cone;
+
+#define RC__CONE_NONE 0   /* no row, or wholly beyond tmax */
+#define RC__CONE_ROWS 1   /* rows i0 .. i1 */
+#define RC__CONE_AROUND 2 /* the origin is in the sphere: any ray */
+
+/* The cone of the sphere about m (map frame, relative to the origin) of
+ * radius rad, whose points lie within far of the origin, as the sensor
+ * turned by r (row-major, sensor to map) sees it. */
+static inline int rc__cone_place(const rc__raster_grid *g, const float r[9], double tmax, const double m[3],
+                                 double rad, double far, rc__cone *c)
+{
+    double u[3], d, rho, alpha, phi_c;
+    int k;
+    /* the sensor frame: the turn's transpose */
+    for (k = 0; k < 3; ++k) u[k] = r[k] * m[0] + r[3 + k] * m[1] + r[6 + k] * m[2];
+    d = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    /* wholly beyond the range (t counts |dir|, within 1e-6 of 1) */
+    if ((d - rad) * (1.0 - 1e-5) > tmax) return RC__CONE_NONE;
+    if (d <= rad * (1.0 + 1e-6)) return RC__CONE_AROUND;
+    rho = sqrt(u[0] * u[0] + u[1] * u[1]);
+    c->slack = RC__CONE_SLACK + RC__CONE_SPREAD_SLACK * far / (d - rad) + RC__CONE_ATAN_ERROR;
+    /* asin(rad / d), and the centre's elevation */
+    alpha = rc__cone_atan2(rad, sqrt(d * d - rad * rad)) + c->slack;
+    phi_c = rc__cone_atan2(u[2], rho);
+    c->lo = phi_c - alpha;
+    c->hi = phi_c + alpha;
+    rc__cone_index_range(g->phi_min, g->phi_inc, g->rows, c->lo, c->hi, &c->i0, &c->i1);
+    return c->i0 <= c->i1 ? RC__CONE_ROWS : RC__CONE_NONE;
+}
+
+/* The azimuths a triangle (corners rel[0..9), map frame, relative to the origin)
+ * spans in the sensor frame, widened by the cone's slack: [*lo, *hi]; 0
+ * when that is every azimuth. Its cone c is clear of the poles, so the
+ * triangle holds neither. A great circle not through a pole crosses each
+ * meridian once, so an edge's azimuths run the short way between its ends'
+ * and the triangle spans the shortest arc that holds its corners' (the
+ * complement of the widest gap between them). An azimuth at elevation phi
+ * takes slack / cos phi, and cos phi >= (pi / 2 - |phi|) * 2 / pi. */
+static inline int rc__cone_azimuths(const rc__cone *c, const float r[9], const float *rel, double *lo, double *hi)
+{
+    const double steep = c->hi > -c->lo ? c->hi : -c->lo;
+    const double slack = c->slack * RC__HALF_PI / (RC__HALF_PI - steep);
+    double th[3], gap, t;
+    int k, widest;
+    for (k = 0; k < 3; ++k) {
+        const float *v = rel + 3 * k;
+        const double x = (double)r[0] * v[0] + (double)r[3] * v[1] + (double)r[6] * v[2];
+        const double y = (double)r[1] * v[0] + (double)r[4] * v[1] + (double)r[7] * v[2];
+        th[k] = rc__cone_atan2(y, x);
+    }
+    /* sorted, then the widest of the three gaps (the last wraps) */
+    if (th[0] > th[1]) t = th[0], th[0] = th[1], th[1] = t;
+    if (th[1] > th[2]) t = th[1], th[1] = th[2], th[2] = t;
+    if (th[0] > th[1]) t = th[0], th[0] = th[1], th[1] = t;
+    widest = 2;
+    gap = th[0] + RC__TWO_PI - th[2];
+    if (th[1] - th[0] > gap) widest = 0, gap = th[1] - th[0];
+    if (th[2] - th[1] > gap) widest = 1;
+    /* the arc starts after the widest gap and ends before it */
+    *lo = th[widest == 2 ? 0 : widest + 1] - slack;
+    *hi = th[widest] + (widest == 2 ? 0.0 : RC__TWO_PI) + slack;
+    return *hi - *lo < RC__TWO_PI && slack < 0.5;
+}
+
+#endif
