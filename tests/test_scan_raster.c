@@ -10,7 +10,8 @@
  * the walls' diagonals (the test's double-precision cases), on a mesh whose
  * zero-area triangles are left unfolded (no ray here rounds into one, so
  * that only shows they change nothing), under turned poses and a mounting,
- * with range limits that cut triangles off. Then through rc_simulate: every
+ * with range limits that cut triangles off, with and without the mesh's
+ * tree; and the placement's atan2 against libm's. Then through rc_simulate: every
  * attribute of a call that takes the projected scan equals, byte for byte,
  * a context without arena room for its scratch (the packets), on 1 and 3
  * threads. */
@@ -20,6 +21,7 @@
 
 #include "backend/backend.h"
 #include "bvh/intersect.h"
+#include "bvh/scan_cone.h"
 #include "bvh/scan_raster.h"
 #include "core/context.h"
 #include "rc_test.h"
@@ -59,6 +61,9 @@ static rc_sensor *grid_sensor(rc_context *ctx, const grid_case *gc, float rmin, 
     return s;
 }
 
+/* 1: check_pose's projected scans without the mesh's tree */
+static int flat;
+
 /* The projected scan of one pose against rc__mesh_intersect ray by ray;
  * returns the rays that hit. */
 static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_pose *pose)
@@ -81,7 +86,16 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
     g.theta_inc = s->spherical.theta.increment;
     assert_true(rc__raster_grid_ok(&g));
     rc__sensor_world_xform(s, pose, &world);
-    rc__raster_scan(mesh, 0u, &g, &world, s->directions, s->range_max, scratch, hits, found, td);
+    if (flat) {
+        /* without the tree (a mesh no built-in commit made): every
+         * triangle placed; the tree back for the search below */
+        rc__mesh bare = *mesh;
+        bare.wide = NULL;
+        bare.wide_count = 0;
+        rc__raster_scan(&bare, 0u, &g, &world, s->directions, s->range_max, scratch, hits, found, td);
+    } else {
+        rc__raster_scan(mesh, 0u, &g, &world, s->directions, s->range_max, scratch, hits, found, td);
+    }
     for (i = 0; i < rays; ++i) {
         rc__ray ray;
         rc__hit want;
@@ -122,6 +136,7 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
     const rc_pose mount = rct_pose_ypr(0.1f, -0.05f, 0.2f, 0.3, 0.2, -0.1);
     uint64_t rays = 0, hit = 0;
     uint32_t k, p;
+    flat = unfold == 2;
     if (unfold) {
         /* the tests' own triples: zero-area triangles whole, checked */
         assert_true(mesh->flats_folded);
@@ -139,6 +154,29 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
     if (hit < min_hits * (double)rays) fail_msg("%llu of %llu rays hit", (unsigned long long)hit, (unsigned long long)rays);
     rc_scene_destroy(scene);
     rc_context_destroy(ctx);
+}
+
+/* The placement's atan2 within its stated error of libm's, all around. */
+static void test_atan2(void **state)
+{
+    double worst = 0.0;
+    int i, k;
+    (void)state;
+    for (i = 0; i < 200000; ++i) {
+        const double a = -3.14159 + 6.28318 * (double)i / 199999.0;
+        for (k = 0; k < 3; ++k) {
+            const double len = k == 0 ? 1e-6 : k == 1 ? 1.0 : 3e7;
+            const double y = len * sin(a), x = len * cos(a);
+            double e = fabs(rc__cone_atan2(y, x) - atan2(y, x));
+            if (e > 3.0) e = fabs(e - RC__TWO_PI); /* the same angle either side of the cut */
+            if (e > worst) worst = e;
+        }
+    }
+    /* the axes and diagonals exactly */
+    assert_true(fabs(rc__cone_atan2(1.0, 0.0) - RC__HALF_PI) <= RC__CONE_ATAN_ERROR);
+    assert_true(fabs(rc__cone_atan2(-2.0, -2.0) + 0.75 * 3.141592653589793) <= RC__CONE_ATAN_ERROR);
+    assert_true(rc__cone_atan2(0.0, 0.0) == 0.0);
+    if (worst > RC__CONE_ATAN_ERROR) fail_msg("worst error %.3g", worst);
 }
 
 static void test_sphere(void **state)
@@ -233,6 +271,8 @@ static void test_unfolded_flats(void **state)
     flats.triangle_count = 3u;
     assert_int_equal(rcu_mesh_append(&m, &flats), 0);
     check_mesh(&m, poses, 2u, 0.0f, 50.0f, 0.45, 1);
+    check_mesh(&m, poses, 2u, 0.0f, 50.0f, 0.45, 2);
+    flat = 0;
     rcu_mesh_free(&flats);
     rcu_mesh_free(&m);
 }
@@ -361,6 +401,7 @@ static void test_simulate(void **state)
 int main(void)
 {
     const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_atan2),
         cmocka_unit_test(test_sphere),
         cmocka_unit_test(test_box_room),
         cmocka_unit_test(test_rare_cases),
