@@ -107,7 +107,15 @@ static inline int rc__cone_place(const rc__raster_grid *g, const float r[9], dou
     d = sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
     /* wholly beyond the range (t counts |dir|, within 1e-6 of 1) */
     if ((d - rad) * (1.0 - 1e-5) > tmax) return RC__CONE_NONE;
-    if (d <= rad * (1.0 + 1e-6)) return RC__CONE_AROUND;
+    if (d <= rad * (1.0 + 1e-6)) {
+        /* every row and azimuth */
+        c->lo = -RC__HALF_PI;
+        c->hi = RC__HALF_PI;
+        c->slack = 0.0;
+        c->i0 = 0;
+        c->i1 = (int64_t)g->rows - 1;
+        return RC__CONE_AROUND;
+    }
     rho = sqrt(u[0] * u[0] + u[1] * u[1]);
     c->slack = RC__CONE_SLACK + RC__CONE_SPREAD_SLACK * far / (d - rad) + RC__CONE_ATAN_ERROR;
     /* asin(rad / d), and the centre's elevation */
