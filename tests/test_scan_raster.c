@@ -192,9 +192,11 @@ static void test_sphere(void **state)
     assert_int_equal(rcu_mesh_uv_sphere(5.0f, 14u, 9u, &m), 0);
     check_mesh(&m, poses, 4u, 0.0f, 100.0f, 0.999, 0);
     rcu_mesh_free(&m);
-    /* finer, and a range that ends short of most of the wall: triangles
-     * wholly beyond it are skipped */
+    /* finer (the corners that touch a cone's edge near more rows), and a
+     * range that ends short of most of the wall: triangles wholly beyond
+     * it are skipped */
     assert_int_equal(rcu_mesh_uv_sphere(5.0f, 60u, 30u, &m), 0);
+    check_mesh(&m, poses, 4u, 0.0f, 100.0f, 0.999, 0);
     check_mesh(&m, poses + 1, 1u, 0.0f, 4.5f, 0.2, 0);
     rcu_mesh_free(&m);
 }

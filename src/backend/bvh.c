@@ -29,10 +29,11 @@
 /* Projected scans (scan_raster.h) for meshes of at most one triangle per
  * this many rays of the scan. A VLP-16 scan (14,400 rays) on the sphere,
  * against the packets: instructions (callgrind, 1 thread) 1k -50%, 10k
- * -21%, 14k -12%, 100k +123%; but time (2 threads, alternated) 1k +60-90%,
- * 3k +5%, 5k +3%, 10k -15% (placing a triangle is a chain of divisions and
- * roots that runs at half the packets' instructions a cycle). */
-#define RC__RASTER_RAYS_PER_TRIANGLE 3u
+ * -29%; time (2 threads, alternated rounds) 4.5k +12 to +27%, 7k +14 to
+ * +20%, 10k -9 to +1% (a scan there runs fewer instructions a cycle than
+ * the packets: it reaches its rays' arrays row by row, triangle by
+ * triangle). */
+#define RC__RASTER_RAYS_PER_TRIANGLE 2u
 /* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
 

@@ -376,6 +376,7 @@ static void raster_rows_all(const raster_tri *tri, const raster_scan *sc)
     for (i = 0; i < sc->g->rows; ++i) test_run(tri, sc, i * sc->g->cols, sc->g->cols);
 }
 
+#if !defined(RC__CONE_LANES)
 /* The rays the triangle's bounding sphere's cone covers. */
 static RC__FORCE_INLINE void raster_triangle(raster_tri *tri, const raster_scan *sc)
 {
@@ -406,28 +407,154 @@ static RC__FORCE_INLINE void raster_triangle(raster_tri *tri, const raster_scan 
     }
 }
 
+#endif
+
+#if defined(RC__CONE_LANES)
+/* n (1..4) triangles placed at once in lanes (scan_cone.h), then each
+ * through the rays it covers, as raster_triangle does one. */
+static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_scan *sc)
+{
+    const rc__raster_grid *g = sc->g;
+    const float *r = sc->r;
+    const rc__v4d zero = rc__v4d_splat(0.0), two_pi = rc__v4d_splat(RC__TWO_PI);
+    double in[3][3][4], lo_out[4], hi_out[4], tlo_out[4], thi_out[4];
+    int64_t skip_out[4], around_out[4], az_out[4];
+    rc__v4d v[3][3], m[3], u[3], r2 = zero, far2 = zero, rad, far, d, rho, slack, q, alpha, phi, lo, hi;
+    rc__v4d th[3], xs, ys, t0, t1, t2, lo3, g0, g1, g2, steep, saz, azlo, azhi;
+    rc__v4l skip, around, w0, w1, az_ok;
+    int c, j, k;
+    for (c = 0; c < 3; ++c)
+        for (j = 0; j < 3; ++j) {
+            for (k = 0; k < 4; ++k) in[c][j][k] = tris[k < n ? k : 0].rel[c][j];
+            memcpy(&v[c][j], in[c][j], sizeof v[c][j]);
+        }
+    for (j = 0; j < 3; ++j) m[j] = (v[0][j] + v[1][j] + v[2][j]) / 3.0;
+    for (c = 0; c < 3; ++c) {
+        const rc__v4d dx = v[c][0] - m[0], dy = v[c][1] - m[1], dz = v[c][2] - m[2];
+        const rc__v4d e2 = dx * dx + dy * dy + dz * dz;
+        const rc__v4d f2 = v[c][0] * v[c][0] + v[c][1] * v[c][1] + v[c][2] * v[c][2];
+        r2 = rc__v4d_max(e2, r2);
+        far2 = rc__v4d_max(f2, far2);
+    }
+    for (j = 0; j < 3; ++j) u[j] = (double)r[j] * m[0] + (double)r[3 + j] * m[1] + (double)r[6 + j] * m[2];
+    {
+        /* the roots lane by lane: the vector extension has none */
+        double a[4], b[4], e[4], f[4];
+        rc__v4d dd = u[0] * u[0] + u[1] * u[1] + u[2] * u[2], hh = u[0] * u[0] + u[1] * u[1];
+        memcpy(a, &r2, sizeof a);
+        memcpy(b, &far2, sizeof b);
+        memcpy(e, &dd, sizeof e);
+        memcpy(f, &hh, sizeof f);
+        for (k = 0; k < 4; ++k) {
+            a[k] = sqrt(a[k]) * (1.0 + 1e-9);
+            b[k] = sqrt(b[k]);
+            e[k] = sqrt(e[k]);
+            f[k] = sqrt(f[k]);
+        }
+        memcpy(&rad, a, sizeof rad);
+        memcpy(&far, b, sizeof far);
+        memcpy(&d, e, sizeof d);
+        memcpy(&rho, f, sizeof rho);
+        {
+            const rc__v4d qq = rc__v4d_max(d * d - rad * rad, zero);
+            memcpy(a, &qq, sizeof a);
+            for (k = 0; k < 4; ++k) a[k] = sqrt(a[k]);
+            memcpy(&q, a, sizeof q);
+        }
+    }
+    skip = (d - rad) * (1.0 - 1e-5) > rc__v4d_splat(sc->tmax);
+    around = d <= rad * (1.0 + 1e-6);
+    slack = RC__CONE_SLACK + RC__CONE_SPREAD_SLACK * far / rc__v4d_select(around, rc__v4d_splat(1.0), d - rad) +
+            RC__CONE_ATAN_ERROR;
+    rc__cone_atan2_4(&rad, &q, &alpha);
+    alpha += slack;
+    rc__cone_atan2_4(&u[2], &rho, &phi);
+    lo = phi - alpha;
+    hi = phi + alpha;
+    /* the corners' azimuths, sorted; the arc is the complement of the widest gap */
+    for (c = 0; c < 3; ++c) {
+        xs = (double)r[0] * v[c][0] + (double)r[3] * v[c][1] + (double)r[6] * v[c][2];
+        ys = (double)r[1] * v[c][0] + (double)r[4] * v[c][1] + (double)r[7] * v[c][2];
+        rc__cone_atan2_4(&ys, &xs, &th[c]);
+    }
+    t0 = rc__v4d_min(th[0], th[1]);
+    t2 = rc__v4d_max(th[0], th[1]);
+    lo3 = rc__v4d_min(t2, th[2]);
+    t2 = rc__v4d_max(t2, th[2]);
+    t1 = rc__v4d_max(t0, lo3);
+    t0 = rc__v4d_min(t0, lo3);
+    g2 = t0 + two_pi - t2;
+    g0 = t1 - t0;
+    g1 = t2 - t1;
+    w0 = g0 > g2;
+    w1 = g1 > rc__v4d_select(w0, g0, g2);
+    steep = rc__v4d_max(hi, -lo);
+    saz = slack * RC__HALF_PI / (RC__HALF_PI - steep);
+    azlo = rc__v4d_select(w1, t2, rc__v4d_select(w0, t1, t0)) - saz;
+    azhi = rc__v4d_select(w1, t1 + two_pi, rc__v4d_select(w0, t0 + two_pi, t2)) + saz;
+    az_ok = (azhi - azlo < two_pi) & (saz < 0.5) & (lo > -RC__HALF_PI) & (hi < RC__HALF_PI);
+    memcpy(lo_out, &lo, sizeof lo_out);
+    memcpy(hi_out, &hi, sizeof hi_out);
+    memcpy(tlo_out, &azlo, sizeof tlo_out);
+    memcpy(thi_out, &azhi, sizeof thi_out);
+    memcpy(skip_out, &skip, sizeof skip_out);
+    memcpy(around_out, &around, sizeof around_out);
+    memcpy(az_out, &az_ok, sizeof az_out);
+    for (k = 0; k < n; ++k) {
+        int64_t i0, i1, i;
+        if (skip_out[k]) continue;
+        if (around_out[k]) {
+            plane(&tris[k], sc);
+            raster_rows_all(&tris[k], sc);
+            continue;
+        }
+        rc__cone_index_range(g->phi_min, g->phi_inc, g->rows, lo_out[k], hi_out[k], &i0, &i1);
+        if (i0 > i1) continue;
+        plane(&tris[k], sc);
+        if (!az_out[k]) {
+            /* a pole in the cone: whole rows */
+            for (i = i0; i <= i1; ++i) test_run(&tris[k], sc, (uint32_t)i * g->cols, g->cols);
+        } else {
+            for (i = i0; i <= i1; ++i) test_row(&tris[k], sc, (uint32_t)i, tlo_out[k], thi_out[k]);
+        }
+    }
+}
+#endif
+
 /* Triangles [first, first + count) of the leaf order. */
 static RC__FORCE_INLINE void raster_slots(const raster_scan *sc, uint32_t first, uint32_t count)
 {
     const rc__mesh *mesh = sc->mesh;
     const float *verts = mesh->vertices;
     const size_t stride = mesh->stride;
+    raster_tri tris[4];
+    int n = 0;
     uint32_t s;
     for (s = first; s < first + count; ++s) {
         const uint32_t *ix = mesh->leaf_tris + (size_t)s * 3u;
-        raster_tri tri;
+        raster_tri *tri = &tris[n];
         int k, c;
         /* a folded flat (a, a, a), or any such triple: never hit */
         if (ix[0] == ix[1] && ix[1] == ix[2]) continue;
         for (c = 0; c < 3; ++c) {
-            tri.v[c] = verts + (size_t)ix[c] * stride;
-            for (k = 0; k < 3; ++k) tri.rel[c][k] = tri.v[c][k] - sc->org[k];
+            tri->v[c] = verts + (size_t)ix[c] * stride;
+            for (k = 0; k < 3; ++k) tri->rel[c][k] = tri->v[c][k] - sc->org[k];
         }
-        tri.slot = s;
+        tri->slot = s;
         /* zero area: never hit (the tests skip what a commit folded) */
-        if (!mesh->flats_folded && rc__tri_zero_area(tri.v[0], tri.v[1], tri.v[2])) continue;
-        raster_triangle(&tri, sc);
+        if (!mesh->flats_folded && rc__tri_zero_area(tri->v[0], tri->v[1], tri->v[2])) continue;
+#if defined(RC__CONE_LANES)
+        if (++n == 4) {
+            raster_four(tris, n, sc);
+            n = 0;
+        }
+#else
+        raster_triangle(tri, sc);
+#endif
     }
+#if defined(RC__CONE_LANES)
+    if (n) raster_four(tris, n, sc);
+#endif
 }
 
 /* The mesh's 4-wide tree from the root, leaves in it placed triangle by
