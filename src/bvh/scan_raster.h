@@ -2,10 +2,10 @@
  * triangle instead of ray by ray. Each triangle's bounding sphere, seen from
  * the sensor, covers a cone; the rows and columns of the scan's grid that can
  * fall in that cone are found from the grid's angles, and only those rays run
- * the watertight test against the triangle. No tree is walked, so on a mesh
- * with far fewer triangles than the scan has rays this costs a few tests a
- * ray where the packets pay their node visits (docs/architecture.md,
- * "Projected scans"). The cone is widened beyond every rounding of the
+ * the watertight test against the triangle. The mesh's tree is walked once a
+ * scan, only to pass over boxes no row meets, so on a mesh with fewer
+ * triangles than the scan has rays this costs a few tests a ray where the
+ * packets pay their node visits (docs/architecture.md, "Projected scans"). The cone is widened beyond every rounding of the
  * test, and each test is rc__tri_intersect_any_area's operations in its
  * order (its rare cases run that function itself), so every ray gets the
  * nearest hit, tie rule included, that any traversal of the tree gives: the
@@ -34,8 +34,8 @@ typedef struct rc__raster_grid {
     double theta_min, theta_inc;
 } rc__raster_grid;
 
-/* 1 when every row's elevation lies within [-pi/2, pi/2] (the cone's rows
- * are then found from the sines of the elevations). */
+/* 1 when every row's elevation lies within [-pi/2, pi/2] (a cone's rows are
+ * found from its elevations, which take only that range). */
 int rc__raster_grid_ok(const rc__raster_grid *g);
 
 /* Scratch bytes rc__raster_scan needs for a scan of `rays` rays (16-byte
