@@ -171,10 +171,10 @@ static RC__FORCE_INLINE void test_ray(const raster_tri *tri, const raster_scan *
 
 #if defined(__GNUC__) && (defined(__SSE2__) || defined(__aarch64__)) && !defined(RC__PACKET_FORCE_SCALAR)
 /* Eight rays at a time in GCC's vector extension (SSE2, AVX2 or NEON; 32-bit
- * ARM's NEON flushes subnormals and keeps the scalar loop): the sign half
- * of the test, whose rejections are the scalar test's own (the same
- * operations, and only lanes without a NaN are rejected here); the rays it
- * leaves run the scalar test. */
+ * ARM's NEON flushes subnormals and keeps the scalar loop): the whole test
+ * in lanes, the scalar test's operations in its order (test8); lanes with a
+ * NaN or a double-precision case, and groups whose rays' axis orders
+ * differ, run the scalar test. */
 #define RC__RASTER_LANES 8u
 typedef float rc__v8f __attribute__((vector_size(32)));
 typedef int32_t rc__v8i __attribute__((vector_size(32)));
