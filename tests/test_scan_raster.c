@@ -11,7 +11,8 @@
  * zero-area triangles are left unfolded (no ray here rounds into one, so
  * that only shows they change nothing), under turned poses and a mounting,
  * with range limits that cut triangles off, with and without the mesh's
- * tree; and the placement's atan2 against libm's. Then through rc_simulate: every
+ * tree, and with every triangle twice (ties); and the placement's atan2
+ * against libm's. Then through rc_simulate: every
  * attribute of a call that takes the projected scan equals, byte for byte,
  * a context without arena room for its scratch (the packets), on 1 and 3
  * threads. */
@@ -156,6 +157,16 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
     rc_context_destroy(ctx);
 }
 
+/* check_mesh with the mesh's tree (its zero-area triangles unfolded when
+ * `unfold`), then without it. */
+static void check_tree_and_flat(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_count, float rmax,
+                                double min_hits, int unfold)
+{
+    check_mesh(m, poses, pose_count, 0.0f, rmax, min_hits, unfold);
+    check_mesh(m, poses, pose_count, 0.0f, rmax, min_hits, 2);
+    flat = 0;
+}
+
 /* The placement's atan2 within its stated error of libm's, all around. */
 static void test_atan2(void **state)
 {
@@ -272,10 +283,25 @@ static void test_unfolded_flats(void **state)
     flats.vertex_count = 9u;
     flats.triangle_count = 3u;
     assert_int_equal(rcu_mesh_append(&m, &flats), 0);
-    check_mesh(&m, poses, 2u, 0.0f, 50.0f, 0.45, 1);
-    check_mesh(&m, poses, 2u, 0.0f, 50.0f, 0.45, 2);
-    flat = 0;
+    check_tree_and_flat(&m, poses, 2u, 50.0f, 0.45, 1);
     rcu_mesh_free(&flats);
+    rcu_mesh_free(&m);
+}
+
+/* Every triangle twice (a copy appended: its own vertices, the same
+ * values): each hit ties, at the same t, with its copy, and the smaller
+ * prim id must win whichever the scan meets first (the offers' tie rule,
+ * taken in lanes and in the scalar offer). */
+static void test_coincident_copies(void **state)
+{
+    rcu_mesh m, copy;
+    const rc_pose poses[] = {rct_pose(0.0f, 0.0f, 0.0f), rct_pose_ypr(1.1f, -0.7f, 0.4f, 2.2, 0.3, -0.5)};
+    (void)state;
+    assert_int_equal(rcu_mesh_uv_sphere(5.0f, 14u, 9u, &m), 0);
+    assert_int_equal(rcu_mesh_uv_sphere(5.0f, 14u, 9u, &copy), 0);
+    assert_int_equal(rcu_mesh_append(&m, &copy), 0);
+    check_tree_and_flat(&m, poses, 2u, 100.0f, 0.999, 0);
+    rcu_mesh_free(&copy);
     rcu_mesh_free(&m);
 }
 
@@ -408,6 +434,7 @@ int main(void)
         cmocka_unit_test(test_box_room),
         cmocka_unit_test(test_rare_cases),
         cmocka_unit_test(test_unfolded_flats),
+        cmocka_unit_test(test_coincident_copies),
         cmocka_unit_test(test_simulate),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -33,7 +33,9 @@
  * +20%, 10k -9 to +1% (a scan there runs fewer instructions a cycle than
  * the packets: it reaches its rays' arrays row by row, triangle by
  * triangle). */
+#ifndef RC__RASTER_RAYS_PER_TRIANGLE /* (overridden to measure other sizes) */
 #define RC__RASTER_RAYS_PER_TRIANGLE 2u
+#endif
 /* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
 

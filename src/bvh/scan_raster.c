@@ -18,9 +18,14 @@
 #define RC__RASTER_CHUNK 32u
 
 /* Per-ray constants of the watertight test, one array each (the shared
- * origin needs no copy): the shear and the axis order, kx | ky << 2 | kz << 4. */
+ * origin needs no copy): the shear and the axis order, kx | ky << 2 | kz << 4;
+ * and each ray's nearest hit so far, its t and leaf-order slot (bs
+ * RC_INVALID_ID: none yet), kept in arrays so that eight rays take their
+ * offers at once in lanes. */
 typedef struct raster_rays {
     float *sx, *sy, *sz;
+    float *bt;
+    uint32_t *bs;
     unsigned char *axes;
 } raster_rays;
 
@@ -28,7 +33,7 @@ static size_t round16(size_t n) { return (n + 15u) & ~(size_t)15u; }
 
 size_t rc__raster_scratch_bytes(uint32_t rays)
 {
-    return 3u * round16((size_t)rays * sizeof(float)) + round16(rays);
+    return 5u * round16((size_t)rays * sizeof(float)) + round16(rays);
 }
 
 static void scratch_split(void *scratch, uint32_t rays, raster_rays *rr)
@@ -38,7 +43,9 @@ static void scratch_split(void *scratch, uint32_t rays, raster_rays *rr)
     rr->sx = (float *)(void *)p;
     rr->sy = (float *)(void *)(p + fl);
     rr->sz = (float *)(void *)(p + 2u * fl);
-    rr->axes = p + 3u * fl;
+    rr->bt = (float *)(void *)(p + 3u * fl);
+    rr->bs = (uint32_t *)(void *)(p + 4u * fl);
+    rr->axes = p + 5u * fl;
 }
 
 int rc__raster_grid_ok(const rc__raster_grid *g)
@@ -114,7 +121,6 @@ typedef struct raster_tri {
     const float *v[3];
     float rel[3][3];
     uint32_t slot;
-    double n[3], w; /* its plane as the refinement takes it */
 } raster_tri;
 
 /* What every test of one scan shares. */
@@ -126,9 +132,6 @@ typedef struct raster_scan {
     const float *r, *org, *dirs;
     const double *rd, *od; /* the turn and origin in double, as the refinement takes them */
     double tmax;
-    rc__hit *hits;
-    int *found;
-    double *td;
 } raster_scan;
 
 /* The ray's full test, for the double-precision cases. */
@@ -140,23 +143,19 @@ RC__COLD int full_test(const raster_tri *tri, const raster_scan *sc, uint32_t ra
     return rc__tri_intersect_any_area(&full, tri->v[0], tri->v[1], tri->v[2], t, &u, &v);
 }
 
-/* A hit at t on ray i offered; the nearest also gets its distance refined
- * as rc__scene_hit_distance_d refines it (the same operations: the plane
- * from the triangle, the direction turned in double), so the writer need
- * not find the triangle again. */
+/* A hit at t on ray i offered: kept when nearer than the ray's best, or as
+ * near with a smaller prim id (rc__hit_offer_slot's rule for one mesh and
+ * no instance; a ray with no hit yet takes a hit at tmax itself). */
 static RC__FORCE_INLINE void offer(const raster_tri *tri, const raster_scan *sc, uint32_t i, float t)
 {
-    const float *p = sc->dirs + (size_t)i * 3u;
-    const double *r = sc->rd;
-    double dx, dy, dz, dn, q;
-    if (!rc__hit_offer_slot(&sc->hits[i], t, sc->mesh->bvh.refs, tri->slot, sc->geom, RC_INVALID_ID)) return;
-    sc->found[i] = 1;
-    dx = r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
-    dy = r[3] * p[0] + r[4] * p[1] + r[5] * p[2];
-    dz = r[6] * p[0] + r[7] * p[1] + r[8] * p[2];
-    dn = tri->n[0] * dx + tri->n[1] * dy + tri->n[2] * dz;
-    q = tri->w / dn;
-    sc->td[i] = dn == 0.0 || !isfinite(q) ? (double)t : q;
+    const uint32_t best = sc->rr.bs[i];
+    if (t > sc->rr.bt[i]) return;
+    if (t == sc->rr.bt[i] && best != RC_INVALID_ID) {
+        const uint32_t *refs = sc->mesh->bvh.refs;
+        if (!(refs[tri->slot] < refs[best])) return;
+    }
+    sc->rr.bt[i] = t;
+    sc->rr.bs[i] = tri->slot;
 }
 
 /* The triangle's test of ray i, and its offer. */
@@ -184,6 +183,9 @@ typedef int32_t rc__v8i __attribute__((vector_size(32)));
 #define splat8(x) ((rc__v8f){(x), (x), (x), (x), (x), (x), (x), (x)})
 #define splat8i(x) ((rc__v8i){(x), (x), (x), (x), (x), (x), (x), (x)})
 
+#define select8(m, a, b) ((rc__v8f)(((rc__v8i)(a) & (m)) | ((rc__v8i)(b) & ~(m))))
+#define select8i(m, a, b) (((a) & (m)) | ((b) & ~(m)))
+
 /* Bit k: lane k of m is set (all ones). */
 static RC__FORCE_INLINE unsigned lanes_bits(const rc__v8i *mask)
 {
@@ -202,11 +204,12 @@ static RC__FORCE_INLINE unsigned lanes_bits(const rc__v8i *mask)
 
 /* The whole test for rays [i, i + 8), all with the axis order `axes`, in
  * lanes: the scalar test's operations in its order, so each lane's t is
- * its t. Bits of *hit: lanes it hits (t in tt[]); of the return: lanes
- * the scalar test must decide (a NaN, whose rejection the lanes do not
- * mirror; a zero edge function; a tiny t). */
+ * its t; its hits nearer than the rays' best taken in lanes. Bits of *tie:
+ * lanes it hits as near as their best (t in tt[]), for offer's tie rule; of
+ * the return: lanes the scalar test must decide (a NaN, whose rejection the
+ * lanes do not mirror; a zero edge function; a tiny t). */
 static RC__FORCE_INLINE unsigned test8(const raster_tri *tri, const raster_scan *sc, uint32_t i, unsigned axes,
-                                       unsigned *hit, float tt_out[8])
+                                       unsigned *tie, float tt_out[8])
 {
     const unsigned kx = axes & 3u, ky = (axes >> 2) & 3u, kz = axes >> 4;
     const float *ra = tri->rel[0], *rb = tri->rel[1], *rc = tri->rel[2];
@@ -235,14 +238,21 @@ static RC__FORCE_INLINE unsigned test8(const raster_tri *tri, const raster_scan 
         const rc__v8i ahead = live & ~zero_edge & (det != zero) & (tt > zero);
         const rc__v8i tiny = tt * splat8(1024.0f) < asz * splat8(depth);
         const rc__v8i hits = ahead & ~tiny, rare = ~ordered | (live & zero_edge) | (ahead & tiny);
+        rc__v8f bt;
+        rc__v8i bs, nearer, same;
+        memcpy(&bt, sc->rr.bt + i, sizeof bt);
+        memcpy(&bs, sc->rr.bs + i, sizeof bs);
+        nearer = hits & (tt < bt);
+        same = hits & (tt == bt);
+        bt = select8(nearer, tt, bt);
+        bs = select8i(nearer, splat8i((int32_t)tri->slot), bs);
+        memcpy(sc->rr.bt + i, &bt, sizeof bt);
+        memcpy(sc->rr.bs + i, &bs, sizeof bs);
         memcpy(tt_out, &tt, sizeof tt);
-        *hit = lanes_bits(&hits);
+        *tie = lanes_bits(&same);
         return lanes_bits(&rare);
     }
 }
-
-#define select8(m, a, b) ((rc__v8f)(((rc__v8i)(a) & (m)) | ((rc__v8i)(b) & ~(m))))
-#define select8i(m, a, b) (((a) & (m)) | ((b) & ~(m)))
 
 /* rays_fill for whole groups of eight rays in lanes: rc__ray_prepare's
  * values (the turn as rc__rot_apply_f, the dominant axis by the same
@@ -313,10 +323,10 @@ static RC__FORCE_INLINE void test_run(const raster_tri *tri, const raster_scan *
         same = (uint64_t)ax[0] * 0x0101010101010101ull;
         if (eight == same) {
             float tt[8];
-            unsigned hit, rare = test8(tri, sc, i, ax[0], &hit, tt);
-            while (hit) {
-                const unsigned k = (unsigned)__builtin_ctz(hit);
-                hit &= hit - 1u;
+            unsigned tie, rare = test8(tri, sc, i, ax[0], &tie, tt);
+            while (tie) {
+                const unsigned k = (unsigned)__builtin_ctz(tie);
+                tie &= tie - 1u;
                 offer(tri, sc, i + k, tt[k]);
             }
             while (rare) {
@@ -356,19 +366,6 @@ static RC__FORCE_INLINE void test_row(const raster_tri *tri, const raster_scan *
     }
 }
 
-/* The triangle's plane as rc__scene_hit_distance_d computes it (a mesh of
- * the scene's own: no instance transform). */
-static void plane(raster_tri *tri, const raster_scan *sc)
-{
-    const double ax = tri->v[0][0], ay = tri->v[0][1], az = tri->v[0][2];
-    const double e1x = tri->v[1][0] - ax, e1y = tri->v[1][1] - ay, e1z = tri->v[1][2] - az;
-    const double e2x = tri->v[2][0] - ax, e2y = tri->v[2][1] - ay, e2z = tri->v[2][2] - az;
-    tri->n[0] = e1y * e2z - e1z * e2y;
-    tri->n[1] = e1z * e2x - e1x * e2z;
-    tri->n[2] = e1x * e2y - e1y * e2x;
-    tri->w = tri->n[0] * (ax - sc->od[0]) + tri->n[1] * (ay - sc->od[1]) + tri->n[2] * (az - sc->od[2]);
-}
-
 /* Every ray of the scan. */
 static void raster_rows_all(const raster_tri *tri, const raster_scan *sc)
 {
@@ -396,7 +393,6 @@ static RC__FORCE_INLINE void raster_triangle(raster_tri *tri, const raster_scan 
     }
     place = rc__cone_place(g, sc->r, sc->tmax, m, sqrt(r2) * (1.0 + 1e-9), sqrt(far2), &c);
     if (place == RC__CONE_NONE) return;
-    plane(tri, sc);
     if (place == RC__CONE_AROUND) {
         raster_rows_all(tri, sc);
     } else if (c.lo <= -RC__HALF_PI || c.hi >= RC__HALF_PI || !rc__cone_azimuths(&c, sc->r, &tri->rel[0][0], &tlo, &thi)) {
@@ -504,13 +500,11 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
         int64_t i0, i1, i;
         if (skip_out[k]) continue;
         if (around_out[k]) {
-            plane(&tris[k], sc);
             raster_rows_all(&tris[k], sc);
             continue;
         }
         rc__cone_index_range(g->phi_min, g->phi_inc, g->rows, lo_out[k], hi_out[k], &i0, &i1);
         if (i0 > i1) continue;
-        plane(&tris[k], sc);
         if (!az_out[k]) {
             /* a pole in the cone: whole rows */
             for (i = i0; i <= i1; ++i) test_run(&tris[k], sc, (uint32_t)i * g->cols, g->cols);
@@ -615,6 +609,60 @@ static __attribute__((target("avx2"), noinline)) void raster_all_avx2(const rast
 #endif
 static void raster_all_base(const raster_scan *sc) { raster_all(sc); }
 
+/* The plane of the triangle with corners v as rc__scene_hit_distance_d
+ * computes it (a mesh of the scene's own: no instance transform), from the
+ * origin od: normal n, offset *w. */
+static void plane(const float *const v[3], const double od[3], double n[3], double *w)
+{
+    const double ax = v[0][0], ay = v[0][1], az = v[0][2];
+    const double e1x = v[1][0] - ax, e1y = v[1][1] - ay, e1z = v[1][2] - az;
+    const double e2x = v[2][0] - ax, e2y = v[2][1] - ay, e2z = v[2][2] - az;
+    n[0] = e1y * e2z - e1z * e2y;
+    n[1] = e1z * e2x - e1x * e2z;
+    n[2] = e1x * e2y - e1y * e2x;
+    *w = n[0] * (ax - od[0]) + n[1] * (ay - od[1]) + n[2] * (az - od[2]);
+}
+
+/* Every ray's nearest hit as the writer takes it: the hit (prim settled),
+ * its flag, and its distance refined in double as rc__scene_hit_distance_d
+ * refines it (the same operations: the plane from the triangle, the
+ * direction turned in double), so the writer need not find the triangle
+ * again. Neighbouring rays mostly share their triangle: its plane is kept. */
+static void settle(const raster_scan *sc, uint32_t rays, rc__hit *hits, int *found, double *td)
+{
+    const rc__mesh *mesh = sc->mesh;
+    const double *r = sc->rd;
+    uint32_t i, last = RC_INVALID_ID;
+    double n[3] = {0.0, 0.0, 0.0}, w = 0.0;
+    for (i = 0; i < rays; ++i) {
+        const uint32_t slot = sc->rr.bs[i];
+        const float t = sc->rr.bt[i];
+        const float *p = sc->dirs + (size_t)i * 3u;
+        double dx, dy, dz, dn, q;
+        hits[i].t = t;
+        hits[i].geom = hits[i].prim = hits[i].inst = hits[i].slot = RC_INVALID_ID;
+        found[i] = slot != RC_INVALID_ID;
+        if (slot == RC_INVALID_ID) continue;
+        hits[i].prim = mesh->bvh.refs[slot];
+        hits[i].geom = sc->geom;
+        hits[i].slot = slot;
+        if (slot != last) {
+            const uint32_t *ix = mesh->leaf_tris + (size_t)slot * 3u;
+            const float *v[3];
+            int c;
+            for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)ix[c] * mesh->stride;
+            plane(v, sc->od, n, &w);
+            last = slot;
+        }
+        dx = r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
+        dy = r[3] * p[0] + r[4] * p[1] + r[5] * p[2];
+        dz = r[6] * p[0] + r[7] * p[1] + r[8] * p[2];
+        dn = n[0] * dx + n[1] * dy + n[2] * dz;
+        q = w / dn;
+        td[i] = dn == 0.0 || !isfinite(q) ? (double)t : q;
+    }
+}
+
 void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const rc__xformf *world,
                      const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found, double *td)
 {
@@ -631,13 +679,9 @@ void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid 
     sc.rd = world->rd;
     sc.od = world->td;
     sc.tmax = (double)tmax;
-    sc.hits = hits;
-    sc.found = found;
-    sc.td = td;
     for (i = 0; i < rays; ++i) {
-        hits[i].t = tmax;
-        hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
-        found[i] = 0;
+        sc.rr.bt[i] = tmax;
+        sc.rr.bs[i] = RC_INVALID_ID;
     }
 #if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__RASTER_LANES)
     if (rc__leaf4_have_avx2())
@@ -645,8 +689,7 @@ void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid 
     else
 #endif
         raster_all_base(&sc);
-    for (i = 0; i < rays; ++i)
-        if (found[i]) rc__hit_settle(&hits[i], mesh->bvh.refs);
+    settle(&sc, rays, hits, found, td);
 }
 #else
 typedef int rc__scan_raster_left_out; /* ISO C: no empty translation unit */
