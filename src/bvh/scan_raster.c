@@ -416,8 +416,8 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
     double in[3][3][4], lo_out[4], hi_out[4], tlo_out[4], thi_out[4];
     int64_t skip_out[4], around_out[4], az_out[4];
     rc__v4d v[3][3], m[3], u[3], r2 = zero, far2 = zero, rad, far, d, rho, slack, q, alpha, phi, lo, hi;
-    rc__v4d th[3], xs, ys, t0, t1, t2, lo3, g0, g1, g2, steep, saz, azlo, azhi;
-    rc__v4l skip, around, w0, w1, az_ok;
+    rc__v4d th[3], el[3], xs, ys, zs, t0, t1, t2, lo3, g0, g1, g2, steep, saz, azlo, azhi, bulge;
+    rc__v4l skip, around, w0, w1, az_ok, clear;
     int c, j, k;
     for (c = 0; c < 3; ++c)
         for (j = 0; j < 3; ++j) {
@@ -467,12 +467,34 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
     rc__cone_atan2_4(&u[2], &rho, &phi);
     lo = phi - alpha;
     hi = phi + alpha;
-    /* the corners' azimuths, sorted; the arc is the complement of the widest gap */
+    /* the corners' azimuths and elevations */
     for (c = 0; c < 3; ++c) {
+        rc__v4d rc;
+        double a[4];
         xs = (double)r[0] * v[c][0] + (double)r[3] * v[c][1] + (double)r[6] * v[c][2];
         ys = (double)r[1] * v[c][0] + (double)r[4] * v[c][1] + (double)r[7] * v[c][2];
+        zs = (double)r[2] * v[c][0] + (double)r[5] * v[c][1] + (double)r[8] * v[c][2];
         rc__cone_atan2_4(&ys, &xs, &th[c]);
+        rc = xs * xs + ys * ys;
+        memcpy(a, &rc, sizeof a);
+        for (k = 0; k < 4; ++k) a[k] = sqrt(a[k]);
+        memcpy(&rc, a, sizeof rc);
+        rc__cone_atan2_4(&zs, &rc, &el[c]);
     }
+    /* the rows: where the cone clears the poles, those the triangle's
+     * corners' elevations reach, widened by the slack and by how far an
+     * edge can bulge beyond its ends (on a great circle |e''| <= tan |e|,
+     * tan |e| <= 1 / (pi/2 - steep) in the cone, and an edge spans at most
+     * 2 alpha: a bulge of at most tan(steep) (2 alpha)^2 / 8). The cone's
+     * rows were half as many again as these on the 10k sphere. */
+    steep = rc__v4d_max(hi, -lo);
+    bulge = alpha * alpha * 0.5 / (RC__HALF_PI - steep) + slack;
+    t0 = rc__v4d_min(rc__v4d_min(el[0], el[1]), el[2]) - bulge;
+    t2 = rc__v4d_max(rc__v4d_max(el[0], el[1]), el[2]) + bulge;
+    clear = (hi < RC__HALF_PI) & (lo > -RC__HALF_PI);
+    lo = rc__v4d_select(clear & (t0 > lo), t0, lo);
+    hi = rc__v4d_select(clear & (t2 < hi), t2, hi);
+    /* the corners' azimuths, sorted; the arc is the complement of the widest gap */
     t0 = rc__v4d_min(th[0], th[1]);
     t2 = rc__v4d_max(th[0], th[1]);
     lo3 = rc__v4d_min(t2, th[2]);
@@ -484,7 +506,6 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
     g1 = t2 - t1;
     w0 = g0 > g2;
     w1 = g1 > rc__v4d_select(w0, g0, g2);
-    steep = rc__v4d_max(hi, -lo);
     saz = slack * RC__HALF_PI / (RC__HALF_PI - steep);
     azlo = rc__v4d_select(w1, t2, rc__v4d_select(w0, t1, t0)) - saz;
     azhi = rc__v4d_select(w1, t1 + two_pi, rc__v4d_select(w0, t0 + two_pi, t2)) + saz;
