@@ -28,13 +28,12 @@
 #define RC__PACKET_MAX_MESHES 32u
 /* Projected scans (scan_raster.h) for meshes of at most one triangle per
  * this many rays of the scan. A VLP-16 scan (14,400 rays) on the sphere,
- * against the packets: instructions (callgrind, 1 thread) 1k -50%, 10k
- * -29%; time (2 threads, alternated rounds) 4.5k +12 to +27%, 7k +14 to
- * +20%, 10k -9 to +1% (a scan there runs fewer instructions a cycle than
- * the packets: it reaches its rays' arrays row by row, triangle by
- * triangle). */
+ * against the packets (session 32): instructions (callgrind, 1 thread) 1k
+ * -57%, 10k -38%; time (2 threads, alternated rounds) 10k +10 to +26%, 14k
+ * and 20k about even (a scan runs fewer instructions a cycle than the
+ * packets: it reaches its rays' arrays row by row, triangle by triangle). */
 #ifndef RC__RASTER_RAYS_PER_TRIANGLE /* (overridden to measure other sizes) */
-#define RC__RASTER_RAYS_PER_TRIANGLE 2u
+#define RC__RASTER_RAYS_PER_TRIANGLE 1u
 #endif
 /* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
