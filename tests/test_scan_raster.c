@@ -181,12 +181,45 @@ static void test_atan2(void **state)
             double e = fabs(rc__cone_atan2(y, x) - atan2(y, x));
             if (e > 3.0) e = fabs(e - RC__TWO_PI); /* the same angle either side of the cut */
             if (e > worst) worst = e;
+#if defined(RC__CONE_LANES)
+            {
+                /* the lanes' version, in every lane */
+                const double ys[4] = {y, -y, y, -y}, xs[4] = {x, x, -x, -x};
+                double got[4];
+                rc__v4d vy, vx, va;
+                int l;
+                memcpy(&vy, ys, sizeof vy);
+                memcpy(&vx, xs, sizeof vx);
+                rc__cone_atan2_4(&vy, &vx, &va);
+                memcpy(got, &va, sizeof got);
+                for (l = 0; l < 4; ++l) {
+                    e = fabs(got[l] - atan2(ys[l], xs[l]));
+                    if (e > 3.0) e = fabs(e - RC__TWO_PI);
+                    if (e > worst) worst = e;
+                }
+            }
+#endif
         }
     }
     /* the axes and diagonals exactly */
     assert_true(fabs(rc__cone_atan2(1.0, 0.0) - RC__HALF_PI) <= RC__CONE_ATAN_ERROR);
     assert_true(fabs(rc__cone_atan2(-2.0, -2.0) + 0.75 * 3.141592653589793) <= RC__CONE_ATAN_ERROR);
     assert_true(rc__cone_atan2(0.0, 0.0) == 0.0);
+#if defined(RC__CONE_LANES)
+    {
+        const double ys[4] = {0.0, 1.0, -2.0, 1e-300}, xs[4] = {0.0, 0.0, -2.0, 1e-300};
+        double got[4];
+        rc__v4d vy, vx, va;
+        memcpy(&vy, ys, sizeof vy);
+        memcpy(&vx, xs, sizeof vx);
+        rc__cone_atan2_4(&vy, &vx, &va);
+        memcpy(got, &va, sizeof got);
+        assert_true(got[0] == 0.0);
+        assert_true(fabs(got[1] - RC__HALF_PI) <= RC__CONE_ATAN_ERROR);
+        assert_true(fabs(got[2] + 0.75 * 3.141592653589793) <= RC__CONE_ATAN_ERROR);
+        assert_true(fabs(got[3] - 0.25 * 3.141592653589793) <= RC__CONE_ATAN_ERROR);
+    }
+#endif
     if (worst > RC__CONE_ATAN_ERROR) fail_msg("worst error %.3g", worst);
 }
 

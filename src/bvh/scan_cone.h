@@ -55,11 +55,13 @@ static inline double rc__cone_atan2(double y, double x)
     const double big = ax > ay ? ax : ay, small = ax > ay ? ay : ax;
     double z, z2, s, a = 0.0;
     if (big == 0.0) return 0.0;
-    z = small / big;
-    if (z > 0.41421356237309503) {
-        /* atan z = pi / 4 + atan((z - 1) / (z + 1)) */
-        z = (z - 1.0) / (z + 1.0);
+    if (small > 0.41421356237309503 * big) {
+        /* atan q = pi / 4 + atan((q - 1) / (q + 1)) for q = small / big:
+         * one division */
+        z = (small - big) / (small + big);
         a = 0.78539816339744831;
+    } else {
+        z = small / big;
     }
     z2 = z * z;
     RC__CONE_ATAN_SERIES(s, z2);
@@ -198,9 +200,10 @@ static RC__CONE_INLINE void rc__cone_atan2_4(const rc__v4d *yp, const rc__v4d *x
     const rc__v4l steep = ay > ax;
     const rc__v4d big = rc__v4d_select(steep, ay, ax), small = rc__v4d_select(steep, ax, ay);
     const rc__v4l none = big == zero;
-    const rc__v4d z0 = small / rc__v4d_select(none, rc__v4d_splat(1.0), big);
-    const rc__v4l fold = z0 > rc__v4d_splat(0.41421356237309503);
-    const rc__v4d z = rc__v4d_select(fold, (z0 - 1.0) / (z0 + 1.0), z0), z2 = z * z;
+    const rc__v4l fold = small > 0.41421356237309503 * big;
+    const rc__v4d z = rc__v4d_select(fold, small - big, small) /
+                      rc__v4d_select(none, rc__v4d_splat(1.0), rc__v4d_select(fold, small + big, big));
+    const rc__v4d z2 = z * z;
     rc__v4d s, a;
     RC__CONE_ATAN_SERIES(s, z2);
     a = rc__v4d_select(fold, rc__v4d_splat(0.78539816339744831), zero) + z * s;
