@@ -184,12 +184,35 @@ static inline int rc__cone_azimuths(const rc__cone *c, const float r[9], const f
  * formulas (the bounds hold for the same reasons; the values may differ in
  * their last bits, which the slack covers many times over). */
 #define RC__CONE_LANES 1
+#include <string.h>
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#else
+#include <arm_neon.h>
+#endif
 typedef double rc__v4d __attribute__((vector_size(32)));
 typedef int64_t rc__v4l __attribute__((vector_size(32)));
 #define rc__v4d_splat(x) ((rc__v4d){(x), (x), (x), (x)})
 #define rc__v4d_select(m, a, b) ((rc__v4d)(((rc__v4l)(a) & (m)) | ((rc__v4l)(b) & ~(m))))
 #define rc__v4d_min(a, b) rc__v4d_select((a) < (b), a, b)
 #define rc__v4d_max(a, b) rc__v4d_select((a) > (b), a, b)
+
+/* Square roots of four lanes in place (the vector extension has none): two
+ * lanes an instruction with SSE2 or AArch64's NEON, as correctly rounded as
+ * libm's. The placement takes eight roots a triangle. */
+static RC__CONE_INLINE void rc__v4d_sqrt(rc__v4d *v)
+{
+    double a[4];
+    memcpy(a, v, sizeof a);
+#if defined(__SSE2__)
+    _mm_storeu_pd(a, _mm_sqrt_pd(_mm_loadu_pd(a)));
+    _mm_storeu_pd(a + 2, _mm_sqrt_pd(_mm_loadu_pd(a + 2)));
+#else
+    vst1q_f64(a, vsqrtq_f64(vld1q_f64(a)));
+    vst1q_f64(a + 2, vsqrtq_f64(vld1q_f64(a + 2)));
+#endif
+    memcpy(v, a, sizeof a);
+}
 
 /* rc__cone_atan2 in lanes, its branches as selects (into *out: no vector
  * returns, which change the calling convention outside the AVX2 build) */

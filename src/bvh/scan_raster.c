@@ -433,31 +433,17 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
         far2 = rc__v4d_max(f2, far2);
     }
     for (j = 0; j < 3; ++j) u[j] = (double)r[j] * m[0] + (double)r[3 + j] * m[1] + (double)r[6 + j] * m[2];
-    {
-        /* the roots lane by lane: the vector extension has none */
-        double a[4], b[4], e[4], f[4];
-        rc__v4d dd = u[0] * u[0] + u[1] * u[1] + u[2] * u[2], hh = u[0] * u[0] + u[1] * u[1];
-        memcpy(a, &r2, sizeof a);
-        memcpy(b, &far2, sizeof b);
-        memcpy(e, &dd, sizeof e);
-        memcpy(f, &hh, sizeof f);
-        for (k = 0; k < 4; ++k) {
-            a[k] = sqrt(a[k]) * (1.0 + 1e-9);
-            b[k] = sqrt(b[k]);
-            e[k] = sqrt(e[k]);
-            f[k] = sqrt(f[k]);
-        }
-        memcpy(&rad, a, sizeof rad);
-        memcpy(&far, b, sizeof far);
-        memcpy(&d, e, sizeof d);
-        memcpy(&rho, f, sizeof rho);
-        {
-            const rc__v4d qq = rc__v4d_max(d * d - rad * rad, zero);
-            memcpy(a, &qq, sizeof a);
-            for (k = 0; k < 4; ++k) a[k] = sqrt(a[k]);
-            memcpy(&q, a, sizeof q);
-        }
-    }
+    rad = r2;
+    far = far2;
+    d = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+    rho = u[0] * u[0] + u[1] * u[1];
+    rc__v4d_sqrt(&rad);
+    rc__v4d_sqrt(&far);
+    rc__v4d_sqrt(&d);
+    rc__v4d_sqrt(&rho);
+    rad *= 1.0 + 1e-9;
+    q = rc__v4d_max(d * d - rad * rad, zero);
+    rc__v4d_sqrt(&q);
     skip = (d - rad) * (1.0 - 1e-5) > rc__v4d_splat(sc->tmax);
     around = d <= rad * (1.0 + 1e-6);
     slack = RC__CONE_SLACK + RC__CONE_SPREAD_SLACK * far / rc__v4d_select(around, rc__v4d_splat(1.0), d - rad) +
@@ -470,15 +456,12 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
     /* the corners' azimuths and elevations */
     for (c = 0; c < 3; ++c) {
         rc__v4d rc;
-        double a[4];
         xs = (double)r[0] * v[c][0] + (double)r[3] * v[c][1] + (double)r[6] * v[c][2];
         ys = (double)r[1] * v[c][0] + (double)r[4] * v[c][1] + (double)r[7] * v[c][2];
         zs = (double)r[2] * v[c][0] + (double)r[5] * v[c][1] + (double)r[8] * v[c][2];
         rc__cone_atan2_4(&ys, &xs, &th[c]);
         rc = xs * xs + ys * ys;
-        memcpy(a, &rc, sizeof a);
-        for (k = 0; k < 4; ++k) a[k] = sqrt(a[k]);
-        memcpy(&rc, a, sizeof rc);
+        rc__v4d_sqrt(&rc);
         rc__cone_atan2_4(&zs, &rc, &el[c]);
     }
     /* the rows: where the cone clears the poles, those the triangle's
