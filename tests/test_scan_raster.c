@@ -93,9 +93,14 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
         rc__mesh bare = *mesh;
         bare.wide = NULL;
         bare.wide_count = 0;
-        rc__raster_scan(&bare, 0u, &g, &world, s->directions, s->range_max, scratch, hits, found, td);
+        rc__raster_scan(&bare, &g, &world, s->directions, s->range_max, scratch);
     } else {
-        rc__raster_scan(mesh, 0u, &g, &world, s->directions, s->range_max, scratch, hits, found, td);
+        rc__raster_scan(mesh, &g, &world, s->directions, s->range_max, scratch);
+    }
+    for (i = 0; i < rays; i += 37u) {
+        /* the hits in runs of 37 rays (the last one shorter) */
+        const uint32_t n = rays - i < 37u ? rays - i : 37u;
+        rc__raster_hits(mesh, 0u, rays, &world, s->directions, scratch, i, n, hits + i, found + i, td + i);
     }
     for (i = 0; i < rays; ++i) {
         rc__ray ray;

@@ -851,7 +851,7 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * scan. The built-in backend, for a spherical sensor on a scene of one mesh
  * with at most one triangle per ray of the scan and no instances, in a
  * call of whole scans for every thread (one thread, or at least four scans a
- * thread), borrows 53 bytes a ray a thread (at most
+ * thread), borrows 21 bytes a ray a thread (at most
  * RC_SIMULATE_SCRATCH_PER_THREAD) to trace each scan triangle by triangle
  * instead (docs/architecture.md, "Projected scans"); without the room it
  * takes the tiles. The results are the same bits either way. */

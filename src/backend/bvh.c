@@ -341,29 +341,30 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 }
 
 #if defined(RC__PROJECTED_SCANS)
-/* Bytes of a projected scan's scratch per thread: the test's constants,
- * then every ray's refined distance, hit and found flag. */
-static size_t raster_stride(uint32_t rays)
-{
-    return rc__raster_scratch_bytes(rays) +
-           (((size_t)rays * (sizeof(double) + sizeof(rc__hit) + sizeof(int)) + 15u) & ~(size_t)15u);
-}
+/* rays a projected scan hands the writer at a time */
+#define RC__RASTER_WRITE_RUN 64u
 
-/* One pose of a projected scan (scan_raster.h), then its results. */
+/* One pose of a projected scan (scan_raster.h), then its results, a run at
+ * a time. */
 static void raster_task(void *user, uint32_t pose, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
+    const rc__mesh *mesh = &job->scene->geoms[0].mesh;
     unsigned char *scratch = run->raster_scratch + (size_t)thread * run->raster_stride;
-    double *td = (double *)(void *)(scratch + rc__raster_scratch_bytes(sensor->rays));
-    rc__hit *hits = (rc__hit *)(void *)(td + sensor->rays);
-    int *found = (int *)(void *)(hits + sensor->rays);
+    rc__hit hits[RC__RASTER_WRITE_RUN];
+    int found[RC__RASTER_WRITE_RUN];
+    double td[RC__RASTER_WRITE_RUN];
     rc__xformf world;
+    uint32_t first;
     rc__job_world_xform(job, pose, &world);
-    rc__raster_scan(&job->scene->geoms[0].mesh, 0u, &run->grid, &world, sensor->directions, sensor->range_max, scratch,
-                    hits, found, td);
-    rc__write_results_run(job, (uint64_t)pose * sensor->rays, 0u, sensor->rays, found, hits, td, &world);
+    rc__raster_scan(mesh, &run->grid, &world, sensor->directions, sensor->range_max, scratch);
+    for (first = 0; first < sensor->rays; first += RC__RASTER_WRITE_RUN) {
+        const uint32_t n = sensor->rays - first < RC__RASTER_WRITE_RUN ? sensor->rays - first : RC__RASTER_WRITE_RUN;
+        rc__raster_hits(mesh, 0u, sensor->rays, &world, sensor->directions, scratch, first, n, hits, found, td);
+        rc__write_results_run(job, (uint64_t)pose * sensor->rays, first, n, found, hits, td, &world);
+    }
 }
 
 /* Sets up a projected scan when it pays: a spherical sensor over a scene of
@@ -388,7 +389,7 @@ static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     run->grid.theta_min = s->spherical.theta.min;
     run->grid.theta_inc = s->spherical.theta.increment;
     if (!rc__raster_grid_ok(&run->grid)) return 0;
-    run->raster_stride = raster_stride(s->rays);
+    run->raster_stride = rc__raster_scratch_bytes(s->rays);
     if (run->raster_stride > RC_SIMULATE_SCRATCH_PER_THREAD) return 0;
     run->raster_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->raster_stride * ctx->thread_count);
     return run->raster_scratch != NULL;

@@ -126,11 +126,9 @@ typedef struct raster_tri {
 /* What every test of one scan shares. */
 typedef struct raster_scan {
     const rc__mesh *mesh;
-    uint32_t geom;
     const rc__raster_grid *g;
     raster_rays rr;
     const float *r, *org, *dirs;
-    const double *rd, *od; /* the turn and origin in double, as the refinement takes them */
     double tmax;
 } raster_scan;
 
@@ -627,61 +625,18 @@ static void plane(const float *const v[3], const double od[3], double n[3], doub
     *w = n[0] * (ax - od[0]) + n[1] * (ay - od[1]) + n[2] * (az - od[2]);
 }
 
-/* Every ray's nearest hit as the writer takes it: the hit (prim settled),
- * its flag, and its distance refined in double as rc__scene_hit_distance_d
- * refines it (the same operations: the plane from the triangle, the
- * direction turned in double), so the writer need not find the triangle
- * again. Neighbouring rays mostly share their triangle: its plane is kept. */
-static void settle(const raster_scan *sc, uint32_t rays, rc__hit *hits, int *found, double *td)
-{
-    const rc__mesh *mesh = sc->mesh;
-    const double *r = sc->rd;
-    uint32_t i, last = RC_INVALID_ID;
-    double n[3] = {0.0, 0.0, 0.0}, w = 0.0;
-    for (i = 0; i < rays; ++i) {
-        const uint32_t slot = sc->rr.bs[i];
-        const float t = sc->rr.bt[i];
-        const float *p = sc->dirs + (size_t)i * 3u;
-        double dx, dy, dz, dn, q;
-        hits[i].t = t;
-        hits[i].geom = hits[i].prim = hits[i].inst = hits[i].slot = RC_INVALID_ID;
-        found[i] = slot != RC_INVALID_ID;
-        if (slot == RC_INVALID_ID) continue;
-        hits[i].prim = mesh->bvh.refs[slot];
-        hits[i].geom = sc->geom;
-        hits[i].slot = slot;
-        if (slot != last) {
-            const uint32_t *ix = mesh->leaf_tris + (size_t)slot * 3u;
-            const float *v[3];
-            int c;
-            for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)ix[c] * mesh->stride;
-            plane(v, sc->od, n, &w);
-            last = slot;
-        }
-        dx = r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
-        dy = r[3] * p[0] + r[4] * p[1] + r[5] * p[2];
-        dz = r[6] * p[0] + r[7] * p[1] + r[8] * p[2];
-        dn = n[0] * dx + n[1] * dy + n[2] * dz;
-        q = w / dn;
-        td[i] = dn == 0.0 || !isfinite(q) ? (double)t : q;
-    }
-}
-
-void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const rc__xformf *world,
-                     const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found, double *td)
+void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__xformf *world, const float *dirs,
+                     float tmax, void *scratch)
 {
     const uint32_t rays = g->rows * g->cols;
     raster_scan sc;
     uint32_t i;
     sc.mesh = mesh;
-    sc.geom = geom;
     sc.g = g;
     scratch_split(scratch, rays, &sc.rr);
     sc.r = world->r;
     sc.org = world->t;
     sc.dirs = dirs;
-    sc.rd = world->rd;
-    sc.od = world->td;
     sc.tmax = (double)tmax;
     for (i = 0; i < rays; ++i) {
         sc.rr.bt[i] = tmax;
@@ -693,7 +648,48 @@ void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid 
     else
 #endif
         raster_all_base(&sc);
-    settle(&sc, rays, hits, found, td);
+}
+
+/* The distance refinement keeps the plane while neighbouring rays share
+ * their triangle. */
+void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
+                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td)
+{
+    const double *r = world->rd;
+    const uint32_t *refs = mesh->bvh.refs, *bs;
+    const float *bt, *p = dirs + (size_t)first * 3u;
+    raster_rays rr;
+    uint32_t i, last = RC_INVALID_ID;
+    double nv[3] = {0.0, 0.0, 0.0}, w = 0.0;
+    scratch_split(scratch, rays, &rr);
+    bs = rr.bs + first;
+    bt = rr.bt + first;
+    for (i = 0; i < n; ++i, p += 3) {
+        const uint32_t slot = bs[i];
+        const float t = bt[i];
+        double dx, dy, dz, dn, q;
+        hits[i].t = t;
+        hits[i].geom = hits[i].prim = hits[i].inst = hits[i].slot = RC_INVALID_ID;
+        found[i] = slot != RC_INVALID_ID;
+        if (slot == RC_INVALID_ID) continue;
+        hits[i].prim = refs[slot];
+        hits[i].geom = geom;
+        hits[i].slot = slot;
+        if (slot != last) {
+            const uint32_t *ix = mesh->leaf_tris + (size_t)slot * 3u;
+            const float *v[3];
+            int c;
+            for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)ix[c] * mesh->stride;
+            plane(v, world->td, nv, &w);
+            last = slot;
+        }
+        dx = r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
+        dy = r[3] * p[0] + r[4] * p[1] + r[5] * p[2];
+        dz = r[6] * p[0] + r[7] * p[1] + r[8] * p[2];
+        dn = nv[0] * dx + nv[1] * dy + nv[2] * dz;
+        q = w / dn;
+        td[i] = dn == 0.0 || !isfinite(q) ? (double)t : q;
+    }
 }
 #else
 typedef int rc__scan_raster_left_out; /* ISO C: no empty translation unit */

@@ -42,15 +42,22 @@ int rc__raster_grid_ok(const rc__raster_grid *g);
  * multiples). */
 size_t rc__raster_scratch_bytes(uint32_t rays);
 
-/* Nearest hits of every ray of one scan on mesh (geometry id geom, no
- * instance): hits[i] and found[i] for ray i = row * cols + column, as
- * rc__mesh_intersect gives them from hits reset to (tmax, no id) (prims
- * settled), and for each hit td[i], its distance refined in double as
- * rc__scene_hit_distance_d gives it. world turns the sensor's unit
- * directions dirs (scan order) into the map frame as the packets'
- * rc__rays_prepare_turned does. scratch: rc__raster_scratch_bytes(rays). */
-void rc__raster_scan(const rc__mesh *mesh, uint32_t geom, const rc__raster_grid *g, const rc__xformf *world,
-                     const float *dirs, float tmax, void *scratch, rc__hit *hits, int *found, double *td);
+/* Traces one scan on mesh (no instance): every ray i = row * cols + column
+ * of the grid, its nearest hit kept in scratch (rc__raster_scratch_bytes(rays))
+ * for rc__raster_hits. world turns the sensor's unit directions dirs (scan
+ * order) into the map frame as the packets' rc__rays_prepare_turned does. */
+void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__xformf *world, const float *dirs,
+                     float tmax, void *scratch);
+
+/* Rays [first, first + n) of the scan of `rays` rays that rc__raster_scan
+ * left in scratch (the same mesh, world and dirs), as the writer takes them:
+ * hits[i] and found[i] for ray first + i as rc__mesh_intersect gives them
+ * from hits reset to (tmax, no id), with geometry id geom and prims
+ * settled, and for each hit td[i], its distance refined in double as
+ * rc__scene_hit_distance_d gives it. A run at a time, so that the writer
+ * reads them from the cache. */
+void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
+                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td);
 
 #endif /* RC__PROJECTED_SCANS */
 
