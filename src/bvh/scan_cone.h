@@ -30,19 +30,18 @@
 #define RC__CONE_SPREAD_SLACK 1e-5
 #define RC__CONE_ATAN_ERROR 1e-9
 
-/* s = the sum of (-z2)^k / (2k + 1) for k = 0..9 (Horner), for a double or
- * a lane vector of them: atan z = z * s where z2 = z * z. */
-#define RC__CONE_ATAN_SERIES(s, z2)                                                                  \
+/* s = the sum of (-z2)^k / (2k + 1) for k = 0..9, for a double or a lane
+ * vector of them (type T): atan z = z * s where z2 = z * z. By Estrin's
+ * scheme, pairs of terms then powers z2^2, z2^4, z2^8: a chain of 7
+ * operations instead of Horner's 18 (the series' latency was 7% of a 10k
+ * scan), the same terms. */
+#define RC__CONE_ATAN_SERIES(T, s, z2)                                                               \
     do {                                                                                             \
-        s = 1.0 / 17.0 - (z2) * (1.0 / 19.0);                                                        \
-        s = 1.0 / 15.0 - (z2) * s;                                                                   \
-        s = 1.0 / 13.0 - (z2) * s;                                                                   \
-        s = 1.0 / 11.0 - (z2) * s;                                                                   \
-        s = 1.0 / 9.0 - (z2) * s;                                                                    \
-        s = 1.0 / 7.0 - (z2) * s;                                                                    \
-        s = 1.0 / 5.0 - (z2) * s;                                                                    \
-        s = 1.0 / 3.0 - (z2) * s;                                                                    \
-        s = 1.0 - (z2) * s;                                                                          \
+        const T u2_ = (z2) * (z2), u4_ = u2_ * u2_, u8_ = u4_ * u4_;                                 \
+        const T p01_ = 1.0 - (z2) * (1.0 / 3.0), p23_ = 1.0 / 5.0 - (z2) * (1.0 / 7.0);            \
+        const T p45_ = 1.0 / 9.0 - (z2) * (1.0 / 11.0), p67_ = 1.0 / 13.0 - (z2) * (1.0 / 15.0);    \
+        const T p89_ = 1.0 / 17.0 - (z2) * (1.0 / 19.0);                                             \
+        s = (p01_ + u2_ * p23_) + u4_ * (p45_ + u2_ * p67_) + u8_ * p89_;                            \
     } while (0)
 
 /* atan2(y, x) within RC__CONE_ATAN_ERROR, without libm's cost (at 10k
@@ -64,7 +63,7 @@ static inline double rc__cone_atan2(double y, double x)
         z = small / big;
     }
     z2 = z * z;
-    RC__CONE_ATAN_SERIES(s, z2);
+    RC__CONE_ATAN_SERIES(double, s, z2);
     a += z * s;
     if (ay > ax) a = RC__HALF_PI - a;
     if (x < 0.0) a = 3.141592653589793 - a;
@@ -228,7 +227,7 @@ static RC__CONE_INLINE void rc__cone_atan2_4(const rc__v4d *yp, const rc__v4d *x
                       rc__v4d_select(none, rc__v4d_splat(1.0), rc__v4d_select(fold, small + big, big));
     const rc__v4d z2 = z * z;
     rc__v4d s, a;
-    RC__CONE_ATAN_SERIES(s, z2);
+    RC__CONE_ATAN_SERIES(rc__v4d, s, z2);
     a = rc__v4d_select(fold, rc__v4d_splat(0.78539816339744831), zero) + z * s;
     a = rc__v4d_select(steep, RC__HALF_PI - a, a);
     a = rc__v4d_select(x < zero, 3.141592653589793 - a, a);
