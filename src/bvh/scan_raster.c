@@ -130,6 +130,7 @@ typedef struct raster_scan {
     raster_rays rr;
     const float *r, *org, *dirs;
     double tmax;
+    double theta_lo, theta_hi; /* the columns' azimuths' range */
 } raster_scan;
 
 /* The ray's full test, for the double-precision cases. */
@@ -347,20 +348,21 @@ static RC__FORCE_INLINE void test_run(const raster_tri *tri, const raster_scan *
 }
 #endif
 
-/* The rays of row `row` whose azimuths lie within [lo, hi] up to whole
- * turns (hi - lo < 2 pi), tested run by run. */
-static RC__FORCE_INLINE void test_row(const raster_tri *tri, const raster_scan *sc, uint32_t row, double lo, double hi)
+/* The rays of rows [i0, i1] whose azimuths lie within [lo, hi] up to whole
+ * turns (hi - lo < 2 pi), tested run by run: each turn's columns found once
+ * for all the rows (the order of the offers changes nothing). */
+static RC__FORCE_INLINE void test_rows(const raster_tri *tri, const raster_scan *sc, int64_t i0, int64_t i1, double lo,
+                                       double hi)
 {
     const rc__raster_grid *g = sc->g;
-    const double last = g->theta_min + (double)(g->cols - 1u) * g->theta_inc;
-    const double tlo = last < g->theta_min ? last : g->theta_min, thi = last < g->theta_min ? g->theta_min : last;
-    const double k_first = ceil((tlo - hi) / RC__TWO_PI), k_last = floor((thi - lo) / RC__TWO_PI);
+    const double k_first = ceil((sc->theta_lo - hi) / RC__TWO_PI), k_last = floor((sc->theta_hi - lo) / RC__TWO_PI);
     double k;
     for (k = k_first; k <= k_last; k += 1.0) {
-        int64_t j0, j1;
+        int64_t j0, j1, i;
         rc__cone_index_range(g->theta_min, g->theta_inc, g->cols, lo + k * RC__TWO_PI, hi + k * RC__TWO_PI, &j0,
                              &j1);
-        if (j0 <= j1) test_run(tri, sc, row * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+        if (j0 > j1) continue;
+        for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
     }
 }
 
@@ -397,7 +399,7 @@ static RC__FORCE_INLINE void raster_triangle(raster_tri *tri, const raster_scan 
         /* a pole in the cone: whole rows */
         for (i = c.i0; i <= c.i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols, g->cols);
     } else {
-        for (i = c.i0; i <= c.i1; ++i) test_row(tri, sc, (uint32_t)i, tlo, thi);
+        test_rows(tri, sc, c.i0, c.i1, tlo, thi);
     }
 }
 
@@ -511,7 +513,7 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
             /* a pole in the cone: whole rows */
             for (i = i0; i <= i1; ++i) test_run(&tris[k], sc, (uint32_t)i * g->cols, g->cols);
         } else {
-            for (i = i0; i <= i1; ++i) test_row(&tris[k], sc, (uint32_t)i, tlo_out[k], thi_out[k]);
+            test_rows(&tris[k], sc, i0, i1, tlo_out[k], thi_out[k]);
         }
     }
 }
@@ -638,6 +640,11 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
     sc.org = world->t;
     sc.dirs = dirs;
     sc.tmax = (double)tmax;
+    {
+        const double last = g->theta_min + (double)(g->cols - 1u) * g->theta_inc;
+        sc.theta_lo = last < g->theta_min ? last : g->theta_min;
+        sc.theta_hi = last < g->theta_min ? g->theta_min : last;
+    }
     for (i = 0; i < rays; ++i) {
         sc.rr.bt[i] = tmax;
         sc.rr.bs[i] = RC_INVALID_ID;
