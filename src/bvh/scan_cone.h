@@ -71,9 +71,11 @@ static inline double rc__cone_atan2(double y, double x)
 }
 
 /* The indices k of values base + k * inc (k < count) within [lo, hi]:
- * [*k0, *k1], empty when *k0 > *k1. */
-static inline void rc__cone_index_range(double base, double inc, uint32_t count, double lo, double hi, int64_t *k0,
-                                        int64_t *k1)
+ * [*k0, *k1], empty when *k0 > *k1. inv = 1 / inc: a multiplication's
+ * rounding only moves a bound that lies within a few ulps of a grid value,
+ * and every [lo, hi] here carries a slack far beyond that. */
+static inline void rc__cone_index_range(double base, double inc, double inv, uint32_t count, double lo, double hi,
+                                        int64_t *k0, int64_t *k1)
 {
     double a, b;
     if (inc == 0.0) {
@@ -82,8 +84,8 @@ static inline void rc__cone_index_range(double base, double inc, uint32_t count,
         *k1 = in ? 0 : -1;
         return;
     }
-    a = (lo - base) / inc;
-    b = (hi - base) / inc;
+    a = (lo - base) * inv;
+    b = (hi - base) * inv;
     if (a > b) {
         const double s = a;
         a = b;
@@ -91,9 +93,14 @@ static inline void rc__cone_index_range(double base, double inc, uint32_t count,
     }
     a = ceil(a);
     b = floor(b);
+    if (!(a <= b) || b < 0.0 || a > (double)count - 1.0) {
+        /* empty (converting a bound far outside the grid would overflow) */
+        *k0 = 0;
+        *k1 = -1;
+        return;
+    }
     *k0 = a < 0.0 ? 0 : (int64_t)a;
     *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
-    if (b < 0.0 || a > (double)count - 1.0) *k1 = *k0 - 1;
 }
 
 /* Where a sphere's cone falls on the grid. */
@@ -136,7 +143,7 @@ static inline int rc__cone_place(const rc__raster_grid *g, const float r[9], dou
     phi_c = rc__cone_atan2(u[2], rho);
     c->lo = phi_c - alpha;
     c->hi = phi_c + alpha;
-    rc__cone_index_range(g->phi_min, g->phi_inc, g->rows, c->lo, c->hi, &c->i0, &c->i1);
+    rc__cone_index_range(g->phi_min, g->phi_inc, g->phi_inv, g->rows, c->lo, c->hi, &c->i0, &c->i1);
     return c->i0 <= c->i1 ? RC__CONE_ROWS : RC__CONE_NONE;
 }
 

@@ -355,12 +355,13 @@ static RC__FORCE_INLINE void test_rows(const raster_tri *tri, const raster_scan 
                                        double hi)
 {
     const rc__raster_grid *g = sc->g;
-    const double k_first = ceil((sc->theta_lo - hi) / RC__TWO_PI), k_last = floor((sc->theta_hi - lo) / RC__TWO_PI);
+    const double turns = 1.0 / RC__TWO_PI; /* (slack covers the rounding, as in rc__cone_index_range) */
+    const double k_first = ceil((sc->theta_lo - hi) * turns), k_last = floor((sc->theta_hi - lo) * turns);
     double k;
     for (k = k_first; k <= k_last; k += 1.0) {
         int64_t j0, j1, i;
-        rc__cone_index_range(g->theta_min, g->theta_inc, g->cols, lo + k * RC__TWO_PI, hi + k * RC__TWO_PI, &j0,
-                             &j1);
+        rc__cone_index_range(g->theta_min, g->theta_inc, g->theta_inv, g->cols, lo + k * RC__TWO_PI,
+                             hi + k * RC__TWO_PI, &j0, &j1);
         if (j0 > j1) continue;
         for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
     }
@@ -507,7 +508,7 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
             raster_rows_all(&tris[k], sc);
             continue;
         }
-        rc__cone_index_range(g->phi_min, g->phi_inc, g->rows, lo_out[k], hi_out[k], &i0, &i1);
+        rc__cone_index_range(g->phi_min, g->phi_inc, g->phi_inv, g->rows, lo_out[k], hi_out[k], &i0, &i1);
         if (i0 > i1) continue;
         if (!az_out[k]) {
             /* a pole in the cone: whole rows */
@@ -631,10 +632,13 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
                      float tmax, void *scratch)
 {
     const uint32_t rays = g->rows * g->cols;
+    rc__raster_grid grid = *g;
     raster_scan sc;
     uint32_t i;
+    grid.phi_inv = g->phi_inc != 0.0 ? 1.0 / g->phi_inc : 0.0;
+    grid.theta_inv = g->theta_inc != 0.0 ? 1.0 / g->theta_inc : 0.0;
     sc.mesh = mesh;
-    sc.g = g;
+    sc.g = &grid;
     scratch_split(scratch, rays, &sc.rr);
     sc.r = world->r;
     sc.org = world->t;

@@ -32,6 +32,8 @@ typedef struct rc__raster_grid {
     uint32_t rows, cols;
     double phi_min, phi_inc;
     double theta_min, theta_inc;
+    /* 1 / phi_inc and 1 / theta_inc (0 for 0): rc__raster_scan sets them */
+    double phi_inv, theta_inv;
 } rc__raster_grid;
 
 /* 1 when every row's elevation lies within [-pi/2, pi/2] (a cone's rows are
