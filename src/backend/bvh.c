@@ -26,14 +26,13 @@
  * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
  * 16 +30%, 32 +13%, 64 even, 128 -18%). */
 #define RC__PACKET_MAX_MESHES 32u
-/* Projected scans (scan_raster.h) for meshes of at most one triangle per
- * this many rays of the scan. A VLP-16 scan (14,400 rays) on the sphere,
- * against the packets (session 32): instructions (callgrind, 1 thread) 1k
- * -57%, 10k -38%; time (2 threads, alternated rounds) 10k +10 to +26%, 14k
- * and 20k about even (a scan runs fewer instructions a cycle than the
- * packets: it reaches its rays' arrays row by row, triangle by triangle). */
-#ifndef RC__RASTER_RAYS_PER_TRIANGLE /* (overridden to measure other sizes) */
-#define RC__RASTER_RAYS_PER_TRIANGLE 1u
+/* Projected scans (scan_raster.h) for meshes of at most this many triangles
+ * per ray of the scan. A VLP-16 scan (14,400 rays) on the sphere against the
+ * packets (session 32, one thread each, run side by side on the two cores):
+ * 10k +20%, 14k +24 to +51%, 20k +2 to +15%, 24k -1 to -9%, 30k -10 to
+ * -22%, 50k -35%. */
+#ifndef RC__RASTER_TRIANGLES_PER_RAY /* (overridden to measure other sizes) */
+#define RC__RASTER_TRIANGLES_PER_RAY 1.25
 #endif
 /* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
@@ -379,7 +378,7 @@ static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     const rc__mesh *mesh;
     if (s->model != RC_SENSOR_SPHERICAL || s->origins || scene->geom_count != 1 || scene->inst_count != 0) return 0;
     mesh = &scene->geoms[0].mesh;
-    if (!mesh->leaf_tris || (uint64_t)mesh->triangle_count * RC__RASTER_RAYS_PER_TRIANGLE > s->rays) return 0;
+    if (!mesh->leaf_tris || (double)mesh->triangle_count > RC__RASTER_TRIANGLES_PER_RAY * (double)s->rays) return 0;
     /* a call of fewer poses than threads keeps them busy with slices */
     if (run->slices > 1) return 0;
     run->grid.rows = s->rows;
