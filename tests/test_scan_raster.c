@@ -1,9 +1,11 @@
-/* Projected scans (bvh/scan_raster.h): a spherical scan traced triangle by
- * triangle must give every ray the hit the tree's single-ray search gives,
- * bit for bit (t, triangle, hit or not), and each hit's distance refined
- * in double as the writer refines the tree's. Checked on grids that wrap, overlap
- * themselves (more than a turn of columns), run backwards, reach within 0.07
- * rad of the poles, or hold one row or one column; in a coarse sphere with
+/* Projected scans (bvh/scan_raster.h): a spherical or cylindrical scan
+ * traced triangle by triangle must give every ray the hit the tree's
+ * single-ray search gives, bit for bit (t, triangle, hit or not), and each
+ * hit's distance refined in double as the writer refines the tree's. Checked
+ * on spherical grids that wrap, overlap themselves (more than a turn of
+ * columns), run backwards, reach within 0.07 rad of the poles, or hold one
+ * row or one column, and cylindrical ones (a panorama, one running backwards
+ * from 73 degrees up to 83 down, one row); in a coarse sphere with
  * the sensor close to its wall (a triangle's bounding sphere around the
  * origin), in a box room with the ceiling across the z axis (a pole inside
  * a triangle), with the sensor in the floor's plane and with rays through
@@ -12,10 +14,10 @@
  * that only shows they change nothing), under turned poses and a mounting,
  * with range limits that cut triangles off, with and without the mesh's
  * tree, and with every triangle twice (ties); and the placement's atan2
- * against libm's. Then through rc_simulate: every
- * attribute of a call that takes the projected scan equals, byte for byte,
- * a context without arena room for its scratch (the packets), on 1 and 3
- * threads. */
+ * against libm's. Then through rc_simulate (a VLP-16 and the cylindrical
+ * panorama): every attribute of a call that takes the projected scan equals,
+ * byte for byte, a context without arena room for its scratch (the packets),
+ * on 1 and 3 threads. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -45,16 +47,49 @@ static const grid_case grids[] = {
     {-1.0f, 0.013f, 500u, 1.0f, -0.11f, 23u},                      /* rows downwards to -1.42 */
 };
 
+/* Cylindrical grids: rows at heights (cy - v) / fy on a unit cylinder. */
+typedef struct cyl_case {
+    float theta_min, theta_inc;
+    uint32_t cols;
+    uint32_t height;
+    float fy, cy;
+} cyl_case;
+
+static const cyl_case cyls[] = {
+    {-3.14159265f, 0.0087266f, 720u, 64u, 40.0f, 31.5f}, /* a panorama, +-38 degrees */
+    {1.0f, -0.02f, 200u, 90u, 6.0f, 20.0f},              /* backwards, 73 degrees up to 83 down */
+    {0.3f, 0.01f, 50u, 1u, 10.0f, -3.0f},                /* one row, 17 degrees up */
+};
+
+/* The range limits, a mounting (NULL: none) and the columns' azimuths. */
+static void set_common(rc_sensor_common *c, rc_angle_axis *theta, float rmin, float rmax, const rc_pose *mount,
+                       float theta_min, float theta_inc, uint32_t cols)
+{
+    c->range_min = rmin;
+    c->range_max = rmax;
+    if (mount) c->sensor_to_base = *mount;
+    theta->min = theta_min;
+    theta->increment = theta_inc;
+    theta->count = cols;
+}
+
+static rc_sensor *cyl_sensor(rc_context *ctx, const cyl_case *cc, float rmin, float rmax, const rc_pose *mount)
+{
+    rc_cylindrical_desc d = rc_cylindrical_desc_default();
+    rc_sensor *s = NULL;
+    set_common(&d.common, &d.theta, rmin, rmax, mount, cc->theta_min, cc->theta_inc, cc->cols);
+    d.height = cc->height;
+    d.fy = cc->fy;
+    d.cy = cc->cy;
+    RCT_OK(ctx, rc_sensor_create_cylindrical(ctx, &d, &s));
+    return s;
+}
+
 static rc_sensor *grid_sensor(rc_context *ctx, const grid_case *gc, float rmin, float rmax, const rc_pose *mount)
 {
     rc_spherical_desc d = rc_spherical_desc_default();
     rc_sensor *s = NULL;
-    d.common.range_min = rmin;
-    d.common.range_max = rmax;
-    if (mount) d.common.sensor_to_base = *mount;
-    d.theta.min = gc->theta_min;
-    d.theta.increment = gc->theta_inc;
-    d.theta.count = gc->cols;
+    set_common(&d.common, &d.theta, rmin, rmax, mount, gc->theta_min, gc->theta_inc, gc->cols);
     d.phi.min = gc->phi_min;
     d.phi.increment = gc->phi_inc;
     d.phi.count = gc->rows;
@@ -79,12 +114,21 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
     int *found = malloc(rays * sizeof *found);
     uint32_t i, hit_count = 0;
     assert_true(scratch && hits && found && td);
+    memset(&g, 0, sizeof g);
     g.rows = s->rows;
     g.cols = s->columns;
-    g.phi_min = s->spherical.phi.min;
-    g.phi_inc = s->spherical.phi.increment;
-    g.theta_min = s->spherical.theta.min;
-    g.theta_inc = s->spherical.theta.increment;
+    if (s->model == RC_SENSOR_CYLINDRICAL) {
+        g.rows_tan = 1;
+        g.row_cy = s->cylindrical.cy;
+        g.row_fy = s->cylindrical.fy;
+        g.theta_min = s->cylindrical.theta.min;
+        g.theta_inc = s->cylindrical.theta.increment;
+    } else {
+        g.phi_min = s->spherical.phi.min;
+        g.phi_inc = s->spherical.phi.increment;
+        g.theta_min = s->spherical.theta.min;
+        g.theta_inc = s->spherical.theta.increment;
+    }
     assert_true(rc__raster_grid_ok(&g));
     rc__sensor_world_xform(s, pose, &world);
     if (flat) {
@@ -149,8 +193,10 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
         rc__mesh_unfold_flats(mesh, (uint32_t *)(uintptr_t)mesh->leaf_tris);
         mesh->flats_folded = 0;
     }
-    for (k = 0; k < sizeof grids / sizeof grids[0]; ++k) {
-        rc_sensor *s = grid_sensor(ctx, &grids[k], rmin, rmax, k == 4 ? &mount : NULL);
+    for (k = 0; k < sizeof grids / sizeof grids[0] + sizeof cyls / sizeof cyls[0]; ++k) {
+        const size_t c = k - sizeof grids / sizeof grids[0];
+        rc_sensor *s = k < sizeof grids / sizeof grids[0] ? grid_sensor(ctx, &grids[k], rmin, rmax, k == 4 ? &mount : NULL)
+                                                        : cyl_sensor(ctx, &cyls[c], rmin, rmax, c == 1 ? &mount : NULL);
         for (p = 0; p < pose_count; ++p) {
             hit += check_pose(scene, s, &poses[p]);
             rays += s->rays;
@@ -422,8 +468,9 @@ static rc_sensor *fill_arena(rc_context *ctx, size_t left)
 }
 
 /* Every attribute of calls with ctx (room for the projected scan's scratch)
- * and tight (none: the packets), byte for byte. */
-static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads)
+ * and tight (none: the packets), byte for byte: a VLP-16, or the first
+ * cylindrical grid. */
+static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads, int cylindrical)
 {
     const uint32_t attrs = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_POINTS | RC_ATTR_NORMALS | RC_ATTR_PRIM_IDS |
                            RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS;
@@ -434,8 +481,13 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m,
     rct_buffers ba, bb;
     uint32_t p, ninf = 0, pinf = 0;
     uint64_t i;
-    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &a));
-    RCT_OK(tight, rc_sensor_create_preset(tight, RC_PRESET_VELODYNE_VLP16, &b));
+    if (cylindrical) {
+        a = cyl_sensor(ctx, &cyls[0], 0.5f, 130.0f, NULL);
+        b = cyl_sensor(tight, &cyls[0], 0.5f, 130.0f, NULL);
+    } else {
+        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &a));
+        RCT_OK(tight, rc_sensor_create_preset(tight, RC_PRESET_VELODYNE_VLP16, &b));
+    }
     /* three of them within 0.2 m of a wall, the ceiling or the ball */
     poses[0] = rct_pose_ypr(-2.0f, 1.5f, 0.0f, 0.3, -0.5, 0.0);
     poses[1] = rct_pose_ypr(-2.8f, -1.8f, 0.1f, 1.2, 0.3, 0.1);
@@ -503,11 +555,14 @@ static void test_simulate(void **state)
     memmove(room.indices, room.indices + 6u, (room.triangle_count - 2u) * 3u * sizeof(uint32_t));
     room.triangle_count -= 2u;
     for (threads = 1; threads <= 3; threads += 2) {
-        rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
-        rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
-        compare_calls(ctx, tight, &room, threads);
-        rc_context_destroy(ctx);
-        rc_context_destroy(tight);
+        int cylindrical;
+        for (cylindrical = 0; cylindrical < 2; ++cylindrical) {
+            rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
+            rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
+            compare_calls(ctx, tight, &room, threads, cylindrical);
+            rc_context_destroy(ctx);
+            rc_context_destroy(tight);
+        }
     }
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&room);

@@ -366,27 +366,38 @@ static void raster_task(void *user, uint32_t pose, uint32_t thread)
     }
 }
 
-/* Sets up a projected scan when it pays: a spherical sensor over a scene of
- * one mesh, no instances, with few triangles against the scan's rays, and
- * the scratch borrowed from the arena's free space (without room the call
- * takes the packets: the same results). Returns 1 when run->raster_scratch
- * was allocated. */
+/* Sets up a projected scan when it pays: a spherical or cylindrical sensor
+ * over a scene of one mesh, no instances, with few triangles against the
+ * scan's rays, and the scratch borrowed from the arena's free space (without
+ * room the call takes the packets: the same results). Returns 1 when
+ * run->raster_scratch was allocated. */
 static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
 {
     const rc_scene *scene = job->scene;
     const rc_sensor *s = job->sensor;
     const rc__mesh *mesh;
-    if (s->model != RC_SENSOR_SPHERICAL || s->origins || scene->geom_count != 1 || scene->inst_count != 0) return 0;
+    if ((s->model != RC_SENSOR_SPHERICAL && s->model != RC_SENSOR_CYLINDRICAL) || s->origins ||
+        scene->geom_count != 1 || scene->inst_count != 0)
+        return 0;
     mesh = &scene->geoms[0].mesh;
     if (!mesh->leaf_tris || (double)mesh->triangle_count > RC__RASTER_TRIANGLES_PER_RAY * (double)s->rays) return 0;
     /* a call of fewer poses than threads keeps them busy with slices */
     if (run->slices > 1) return 0;
+    memset(&run->grid, 0, sizeof run->grid);
     run->grid.rows = s->rows;
     run->grid.cols = s->columns;
-    run->grid.phi_min = s->spherical.phi.min;
-    run->grid.phi_inc = s->spherical.phi.increment;
-    run->grid.theta_min = s->spherical.theta.min;
-    run->grid.theta_inc = s->spherical.theta.increment;
+    if (s->model == RC_SENSOR_SPHERICAL) {
+        run->grid.phi_min = s->spherical.phi.min;
+        run->grid.phi_inc = s->spherical.phi.increment;
+        run->grid.theta_min = s->spherical.theta.min;
+        run->grid.theta_inc = s->spherical.theta.increment;
+    } else {
+        run->grid.rows_tan = 1;
+        run->grid.row_cy = s->cylindrical.cy;
+        run->grid.row_fy = s->cylindrical.fy;
+        run->grid.theta_min = s->cylindrical.theta.min;
+        run->grid.theta_inc = s->cylindrical.theta.increment;
+    }
     if (!rc__raster_grid_ok(&run->grid)) return 0;
     run->raster_stride = rc__raster_scratch_bytes(s->rays);
     if (run->raster_stride > RC_SIMULATE_SCRATCH_PER_THREAD) return 0;

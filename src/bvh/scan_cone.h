@@ -103,6 +103,22 @@ static inline void rc__cone_index_range(double base, double inc, double inv, uin
     *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
 }
 
+/* The rows whose elevations lie within [lo, hi]: [*i0, *i1], empty when
+ * *i0 > *i1. A cylindrical grid's row v = cy - fy tan(e) falls as e rises
+ * (libm's tan is within an ulp or so: the slack covers it); elevations
+ * beyond +-pi/2 reach the last row on that side. */
+static inline void rc__cone_rows(const rc__raster_grid *g, double lo, double hi, int64_t *i0, int64_t *i1)
+{
+    double top, bottom;
+    if (!g->rows_tan) {
+        rc__cone_index_range(g->phi_min, g->phi_inc, g->phi_inv, g->rows, lo, hi, i0, i1);
+        return;
+    }
+    top = hi >= RC__HALF_PI ? -HUGE_VAL : g->row_cy - g->row_fy * tan(hi);
+    bottom = lo <= -RC__HALF_PI ? HUGE_VAL : g->row_cy - g->row_fy * tan(lo);
+    rc__cone_index_range(0.0, 1.0, 1.0, g->rows, top, bottom, i0, i1);
+}
+
 /* Where a sphere's cone falls on the grid. */
 typedef struct rc__cone {
     double lo, hi;  /* its elevations (radians, slack included) */
@@ -143,7 +159,7 @@ static inline int rc__cone_place(const rc__raster_grid *g, const float r[9], dou
     phi_c = rc__cone_atan2(u[2], rho);
     c->lo = phi_c - alpha;
     c->hi = phi_c + alpha;
-    rc__cone_index_range(g->phi_min, g->phi_inc, g->phi_inv, g->rows, c->lo, c->hi, &c->i0, &c->i1);
+    rc__cone_rows(g, c->lo, c->hi, &c->i0, &c->i1);
     return c->i0 <= c->i1 ? RC__CONE_ROWS : RC__CONE_NONE;
 }
 

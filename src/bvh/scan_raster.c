@@ -1,5 +1,6 @@
 /* Projected scans (scan_raster.h): each triangle of a small mesh meets only
- * the rays of a spherical scan that its bounding cone covers. */
+ * the rays of a spherical or cylindrical scan that its bounding cone
+ * covers. */
 #include "bvh/scan_raster.h"
 
 #if defined(RC__PROJECTED_SCANS)
@@ -52,8 +53,9 @@ int rc__raster_grid_ok(const rc__raster_grid *g)
 {
     const double half_pi = 1.5707963267948966;
     const double last = g->phi_min + (double)(g->rows - 1u) * g->phi_inc;
-    return g->rows > 0 && g->cols > 0 && g->phi_min >= -half_pi && g->phi_min <= half_pi && last >= -half_pi &&
-           last <= half_pi;
+    if (g->rows == 0 || g->cols == 0) return 0;
+    if (g->rows_tan) return g->row_fy > 0.0 && isfinite(g->row_fy) && isfinite(g->row_cy);
+    return g->phi_min >= -half_pi && g->phi_min <= half_pi && last >= -half_pi && last <= half_pi;
 }
 
 /* Rays [from, rays) of the scan prepared as the packets prepare them, kept
@@ -508,7 +510,7 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
             raster_rows_all(&tris[k], sc);
             continue;
         }
-        rc__cone_index_range(g->phi_min, g->phi_inc, g->phi_inv, g->rows, lo_out[k], hi_out[k], &i0, &i1);
+        rc__cone_rows(g, lo_out[k], hi_out[k], &i0, &i1);
         if (i0 > i1) continue;
         if (!az_out[k]) {
             /* a pole in the cone: whole rows */

@@ -1,15 +1,15 @@
-/* Projected scans: a spherical scan of a small mesh traced triangle by
- * triangle instead of ray by ray. Each triangle's bounding sphere, seen from
- * the sensor, covers a cone; the rows and columns of the scan's grid that can
- * fall in that cone are found from the grid's angles, and only those rays run
- * the watertight test against the triangle. The mesh's tree is walked once a
- * scan, only to pass over boxes no row meets, so on a mesh with fewer
- * triangles than the scan has rays this costs a few tests a ray where the
- * packets pay their node visits (docs/architecture.md, "Projected scans"). The cone is widened beyond every rounding of the
- * test, and each test is rc__tri_intersect_any_area's operations in its
- * order (its rare cases run that function itself), so every ray gets the
- * nearest hit, tie rule included, that any traversal of the tree gives: the
- * same bits. */
+/* Projected scans: a spherical or cylindrical scan of a small mesh traced
+ * triangle by triangle instead of ray by ray. Each triangle's bounding
+ * sphere, seen from the sensor, covers a cone; the rows and columns of the
+ * scan's grid that can fall in that cone are found from the grid's angles,
+ * and only those rays run the watertight test against the triangle. The
+ * mesh's tree is walked once a scan, only to pass over boxes no row meets,
+ * so on a mesh with fewer triangles than the scan has rays this costs a few
+ * tests a ray where the packets pay their node visits (docs/architecture.md,
+ * "Projected scans"). The cone is widened beyond every rounding of the test,
+ * and each test is rc__tri_intersect_any_area's operations in its order (its
+ * rare cases run that function itself), so every ray gets the nearest hit,
+ * tie rule included, that any traversal of the tree gives: the same bits. */
 #ifndef RC_BVH_SCAN_RASTER_H
 #define RC_BVH_SCAN_RASTER_H
 
@@ -27,17 +27,23 @@
 #define RC__PROJECTED_SCANS 1
 
 /* A spherical grid: ray (row i, column j) points along phi_min + i * phi_inc
- * (elevation) and theta_min + j * theta_inc (azimuth), x forward, z up. */
+ * (elevation) and theta_min + j * theta_inc (azimuth), x forward, z up. A
+ * cylindrical one (rows_tan 1) has the same columns, and row v at the
+ * elevation atan((row_cy - v) / row_fy), row_fy > 0 (rc_cylindrical_desc):
+ * phi_min and phi_inc are then unused. */
 typedef struct rc__raster_grid {
     uint32_t rows, cols;
     double phi_min, phi_inc;
     double theta_min, theta_inc;
+    int rows_tan;
+    double row_cy, row_fy;
     /* 1 / phi_inc and 1 / theta_inc (0 for 0): rc__raster_scan sets them */
     double phi_inv, theta_inv;
 } rc__raster_grid;
 
 /* 1 when every row's elevation lies within [-pi/2, pi/2] (a cone's rows are
- * found from its elevations, which take only that range). */
+ * found from its elevations, which take only that range): always so for a
+ * cylindrical grid with row_fy > 0. */
 int rc__raster_grid_ok(const rc__raster_grid *g);
 
 /* Scratch bytes rc__raster_scan needs for a scan of `rays` rays (16-byte
