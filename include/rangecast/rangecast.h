@@ -849,7 +849,7 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * to trace the call's tiles in the order of the map rather than scan by scan
  * (faster on maps the cache cannot hold); without that room they run scan by
  * scan. The built-in backend, for a spherical or cylindrical sensor on a
- * scene of one mesh with at most 1.25 triangles per ray of the scan and no
+ * scene of one mesh with at most one triangle per ray of the scan and no
  * instances, in a call of whole scans for every thread (one thread, or at
  * least four scans a thread), borrows 21 bytes a ray a thread (at most
  * RC_SIMULATE_SCRATCH_PER_THREAD) to trace each scan triangle by triangle

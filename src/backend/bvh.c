@@ -27,12 +27,13 @@
  * 16 +30%, 32 +13%, 64 even, 128 -18%). */
 #define RC__PACKET_MAX_MESHES 32u
 /* Projected scans (scan_raster.h) for meshes of at most this many triangles
- * per ray of the scan. A VLP-16 scan (14,400 rays) on the sphere against the
- * packets (session 32, one thread each, run side by side on the two cores):
- * 10k +20%, 14k +24 to +51%, 20k +2 to +15%, 24k -1 to -9%, 30k -10 to
- * -22%, 50k -35%. */
+ * per ray of the scan. On the sphere against the packets (session 32, one
+ * thread each, run side by side on the two cores): a VLP-16 (14,400 rays)
+ * at 10k +39 to +44%, 14k +24 to +51%, 20k +2 to +15%, 24k -1 to -9%, 30k
+ * -10 to -22%; an OS1-64 (65,536 rays) at 30k +45 to +50%, 50k +8 to +13%,
+ * 65k even, 80k -5 to -14%. */
 #ifndef RC__RASTER_TRIANGLES_PER_RAY /* (overridden to measure other sizes) */
-#define RC__RASTER_TRIANGLES_PER_RAY 1.25
+#define RC__RASTER_TRIANGLES_PER_RAY 1.0
 #endif
 /* sim_run.large holds one bit per mesh */
 typedef char rc__packet_meshes_check[RC__PACKET_MAX_MESHES <= 32u ? 1 : -1];
