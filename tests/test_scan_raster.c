@@ -1,11 +1,14 @@
-/* Projected scans (bvh/scan_raster.h): a spherical or cylindrical scan
- * traced triangle by triangle must give every ray the hit the tree's
+/* Projected scans (bvh/scan_raster.h): a spherical, cylindrical or pinhole
+ * scan traced triangle by triangle must give every ray the hit the tree's
  * single-ray search gives, bit for bit (t, triangle, hit or not), and each
  * hit's distance refined in double as the writer refines the tree's. Checked
  * on spherical grids that wrap, overlap themselves (more than a turn of
  * columns), run backwards, reach within 0.07 rad of the poles, or hold one
  * row or one column, and cylindrical ones (a panorama, one running backwards
- * from 73 degrees up to 83 down, one row); in a coarse sphere with
+ * from 73 degrees up to 83 down, one row), and pinhole ones (body and
+ * optical frames, a principal point off the image, a long lens, a 143
+ * degree one, one row, one column); whole, and in bands of rows; in a
+ * coarse sphere with
  * the sensor close to its wall (a triangle's bounding sphere around the
  * origin), in a box room with the ceiling across the z axis (a pole inside
  * a triangle), with the sensor in the floor's plane and with rays through
@@ -13,9 +16,10 @@
  * zero-area triangles are left unfolded (no ray here rounds into one, so
  * that only shows they change nothing), under turned poses and a mounting,
  * with range limits that cut triangles off, with and without the mesh's
- * tree, and with every triangle twice (ties); and the placement's atan2
- * against libm's. Then through rc_simulate (a VLP-16 and the cylindrical
- * panorama): every attribute of a call that takes the projected scan equals,
+ * tree, and with every triangle twice (ties); a long lens on a wall of
+ * tiny triangles whose corners lie on its pixels' rays; and the placement's
+ * atan2 against libm's. Then through rc_simulate (a VLP-16, the cylindrical
+ * panorama and a camera): every attribute of a call that takes the projected scan equals,
  * byte for byte, a context without arena room for its scratch (the packets),
  * on 1 and 3 threads. */
 #include <math.h>
@@ -61,6 +65,26 @@ static const cyl_case cyls[] = {
     {0.3f, 0.01f, 50u, 1u, 10.0f, -3.0f},                /* one row, 17 degrees up */
 };
 
+/* Pinhole grids: pixel (v, u) along optical ((u - cx) / fx, (v - cy) / fy, 1). */
+typedef struct cam_case {
+    uint32_t width, height;
+    float fx, fy, cx, cy;
+    uint32_t frame;
+} cam_case;
+
+static const cam_case cams[] = {
+    {64u, 48u, 40.0f, 40.0f, 31.5f, 24.0f, RC_PINHOLE_FRAME_BODY},      /* a depth camera's 77 x 62 degrees */
+    {50u, 30u, 30.0f, 45.0f, -10.0f, 40.0f, RC_PINHOLE_FRAME_OPTICAL}, /* the principal point off the image */
+    {40u, 30u, 2000.0f, 2000.0f, 20.0f, 15.0f, RC_PINHOLE_FRAME_BODY}, /* a long lens: 1.1 degrees */
+    {60u, 40u, 10.0f, 10.0f, 29.5f, 19.5f, RC_PINHOLE_FRAME_OPTICAL},  /* 143 x 126 degrees */
+    {40u, 1u, 25.0f, 25.0f, 19.0f, 0.3f, RC_PINHOLE_FRAME_BODY},       /* one row */
+    {1u, 25u, 25.0f, 20.0f, 0.0f, 12.0f, RC_PINHOLE_FRAME_OPTICAL},    /* one column */
+};
+
+#define NGRIDS (uint32_t)(sizeof grids / sizeof grids[0])
+#define NCYLS (uint32_t)(sizeof cyls / sizeof cyls[0])
+#define NCAMS (uint32_t)(sizeof cams / sizeof cams[0])
+
 /* The range limits, a mounting (NULL: none) and the columns' azimuths. */
 static void set_common(rc_sensor_common *c, rc_angle_axis *theta, float rmin, float rmax, const rc_pose *mount,
                        float theta_min, float theta_inc, uint32_t cols)
@@ -85,6 +109,23 @@ static rc_sensor *cyl_sensor(rc_context *ctx, const cyl_case *cc, float rmin, fl
     return s;
 }
 
+static rc_sensor *cam_sensor(rc_context *ctx, const cam_case *cc, float rmin, float rmax, const rc_pose *mount)
+{
+    rc_pinhole_desc d = rc_pinhole_desc_default();
+    rc_angle_axis unused;
+    rc_sensor *s = NULL;
+    set_common(&d.common, &unused, rmin, rmax, mount, 0.0f, 0.0f, 0u);
+    d.frame = cc->frame;
+    d.width = cc->width;
+    d.height = cc->height;
+    d.fx = cc->fx;
+    d.fy = cc->fy;
+    d.cx = cc->cx;
+    d.cy = cc->cy;
+    RCT_OK(ctx, rc_sensor_create_pinhole(ctx, &d, &s));
+    return s;
+}
+
 static rc_sensor *grid_sensor(rc_context *ctx, const grid_case *gc, float rmin, float rmax, const rc_pose *mount)
 {
     rc_spherical_desc d = rc_spherical_desc_default();
@@ -99,6 +140,40 @@ static rc_sensor *grid_sensor(rc_context *ctx, const grid_case *gc, float rmin, 
 
 /* 1: check_pose's projected scans without the mesh's tree */
 static int flat;
+/* rows a band of check_pose's scans (0: the whole scan at once) */
+static uint32_t band_rows;
+
+/* The projected scan of rows [row0, row0 + rows) of g into hits, found and
+ * td (the whole scan's arrays), its hits in runs of 37 rays (the last one
+ * shorter). */
+static void scan_band(const rc_scene *scene, const rc_sensor *s, const rc__raster_grid *g, const rc__xformf *world,
+                      uint32_t row0, uint32_t rows, rc__hit *hits, int *found, double *td)
+{
+    const rc__mesh *mesh = &scene->geoms[0].mesh;
+    const uint32_t base = row0 * g->cols, n_rays = rows * g->cols;
+    const float *dirs = s->directions + (size_t)base * 3u;
+    void *scratch = malloc(rc__raster_scratch_bytes(n_rays));
+    rc__raster_grid band;
+    uint32_t i;
+    assert_non_null(scratch);
+    rc__raster_band(g, row0, rows, &band);
+    if (flat) {
+        /* without the tree (a mesh no built-in commit made): every
+         * triangle placed; the tree back for the search below */
+        rc__mesh bare = *mesh;
+        bare.wide = NULL;
+        bare.wide_count = 0;
+        rc__raster_scan(&bare, &band, world, dirs, s->range_max, scratch);
+    } else {
+        rc__raster_scan(mesh, &band, world, dirs, s->range_max, scratch);
+    }
+    for (i = 0; i < n_rays; i += 37u) {
+        const uint32_t n = n_rays - i < 37u ? n_rays - i : 37u;
+        rc__raster_hits(mesh, 0u, n_rays, world, dirs, scratch, i, n, hits + base + i, found + base + i,
+                        td + base + i);
+    }
+    free(scratch);
+}
 
 /* The projected scan of one pose against rc__mesh_intersect ray by ray;
  * returns the rays that hit. */
@@ -108,43 +183,16 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
     rc__raster_grid g;
     rc__xformf world;
     const uint32_t rays = s->rays;
-    void *scratch = malloc(rc__raster_scratch_bytes(rays));
     rc__hit *hits = malloc(rays * sizeof *hits);
     double *td = malloc(rays * sizeof *td);
     int *found = malloc(rays * sizeof *found);
-    uint32_t i, hit_count = 0;
-    assert_true(scratch && hits && found && td);
-    memset(&g, 0, sizeof g);
-    g.rows = s->rows;
-    g.cols = s->columns;
-    if (s->model == RC_SENSOR_CYLINDRICAL) {
-        g.rows_tan = 1;
-        g.row_cy = s->cylindrical.cy;
-        g.row_fy = s->cylindrical.fy;
-        g.theta_min = s->cylindrical.theta.min;
-        g.theta_inc = s->cylindrical.theta.increment;
-    } else {
-        g.phi_min = s->spherical.phi.min;
-        g.phi_inc = s->spherical.phi.increment;
-        g.theta_min = s->spherical.theta.min;
-        g.theta_inc = s->spherical.theta.increment;
-    }
-    assert_true(rc__raster_grid_ok(&g));
+    uint32_t i, row0, hit_count = 0;
+    assert_true(hits && found && td);
+    assert_true(rc__raster_grid_of(s, &g));
     rc__sensor_world_xform(s, pose, &world);
-    if (flat) {
-        /* without the tree (a mesh no built-in commit made): every
-         * triangle placed; the tree back for the search below */
-        rc__mesh bare = *mesh;
-        bare.wide = NULL;
-        bare.wide_count = 0;
-        rc__raster_scan(&bare, &g, &world, s->directions, s->range_max, scratch);
-    } else {
-        rc__raster_scan(mesh, &g, &world, s->directions, s->range_max, scratch);
-    }
-    for (i = 0; i < rays; i += 37u) {
-        /* the hits in runs of 37 rays (the last one shorter) */
-        const uint32_t n = rays - i < 37u ? rays - i : 37u;
-        rc__raster_hits(mesh, 0u, rays, &world, s->directions, scratch, i, n, hits + i, found + i, td + i);
+    for (row0 = 0; row0 < g.rows; row0 += band_rows ? band_rows : g.rows) {
+        const uint32_t n = band_rows && g.rows - row0 > band_rows ? band_rows : g.rows - row0;
+        scan_band(scene, s, &g, &world, row0, n, hits, found, td);
     }
     for (i = 0; i < rays; ++i) {
         rc__ray ray;
@@ -169,7 +217,6 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
                 fail_msg("ray %u: refined %.17g, the writer's %.17g", i, td[i], want_td);
         }
     }
-    free(scratch);
     free(td);
     free(hits);
     free(found);
@@ -193,14 +240,21 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
         rc__mesh_unfold_flats(mesh, (uint32_t *)(uintptr_t)mesh->leaf_tris);
         mesh->flats_folded = 0;
     }
-    for (k = 0; k < sizeof grids / sizeof grids[0] + sizeof cyls / sizeof cyls[0]; ++k) {
-        const size_t c = k - sizeof grids / sizeof grids[0];
-        rc_sensor *s = k < sizeof grids / sizeof grids[0] ? grid_sensor(ctx, &grids[k], rmin, rmax, k == 4 ? &mount : NULL)
-                                                        : cyl_sensor(ctx, &cyls[c], rmin, rmax, c == 1 ? &mount : NULL);
+    for (k = 0; k < NGRIDS + NCYLS + NCAMS; ++k) {
+        rc_sensor *s;
+        if (k < NGRIDS)
+            s = grid_sensor(ctx, &grids[k], rmin, rmax, k == 4 ? &mount : NULL);
+        else if (k < NGRIDS + NCYLS)
+            s = cyl_sensor(ctx, &cyls[k - NGRIDS], rmin, rmax, k == NGRIDS + 1u ? &mount : NULL);
+        else
+            s = cam_sensor(ctx, &cams[k - NGRIDS - NCYLS], rmin, rmax, k == NGRIDS + NCYLS + 1u ? &mount : NULL);
         for (p = 0; p < pose_count; ++p) {
+            /* every other pose in bands of a third of the rows */
+            band_rows = p % 2u ? s->rows / 3u + 1u : 0u;
             hit += check_pose(scene, s, &poses[p]);
             rays += s->rays;
         }
+        band_rows = 0;
         rc_sensor_destroy(s);
     }
     if (hit < min_hits * (double)rays) fail_msg("%llu of %llu rays hit", (unsigned long long)hit, (unsigned long long)rays);
@@ -421,6 +475,54 @@ static void test_edges_on_rows(void **state)
     rcu_mesh_free(&m);
 }
 
+/* A long lens (1.1 degrees across) facing a wall of tiny triangles 30 m
+ * away whose corners lie on its pixels' rays (the sensor's own unit
+ * directions, scaled): every ray runs through a corner shared by six
+ * triangles, and the pixels found from the projected corners must still
+ * give each ray all of them (the watertight test then picks one). */
+static void test_corners_on_pixels(void **state)
+{
+    const cam_case lens = cams[2];
+    cam_case wider = lens;
+    const rc_pose poses[] = {rct_pose(0.0f, 0.0f, 0.0f), rct_pose_ypr(0.0f, 0.0f, 0.0f, 0.0, 0.0, 0.0)};
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_sensor *sensor = cam_sensor(ctx, &lens, 0.0f, 50.0f, NULL), *grid;
+    rc_scene *scene;
+    rcu_mesh m;
+    uint32_t u, v, p;
+    (void)state;
+    /* one pixel more on each side: the same rays, as (u - cx) is exact */
+    wider.width += 2u;
+    wider.height += 2u;
+    wider.cx += 1.0f;
+    wider.cy += 1.0f;
+    grid = cam_sensor(ctx, &wider, 0.0f, 50.0f, NULL);
+    assert_int_equal(rcu_mesh_reserve(&m, grid->rays, 2u * (wider.width - 1u) * (wider.height - 1u)), 0);
+    for (u = 0; u < grid->rays; ++u) {
+        float *x = m.vertices + 3u * m.vertex_count++;
+        for (v = 0; v < 3u; ++v) x[v] = 30.0f * grid->directions[3u * u + v];
+    }
+    for (v = 0; v + 1u < wider.height; ++v)
+        for (u = 0; u + 1u < wider.width; ++u) {
+            const uint32_t q = v * wider.width + u, down = q + wider.width;
+            uint32_t *t = m.indices + 3u * m.triangle_count;
+            t[0] = q, t[1] = q + 1u, t[2] = down + 1u;
+            t[3] = q, t[4] = down + 1u, t[5] = down;
+            m.triangle_count += 2u;
+        }
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    for (p = 0; p < 2u; ++p) {
+        band_rows = p ? 7u : 0u;
+        assert_int_equal(check_pose(scene, sensor, &poses[p]), sensor->rays);
+    }
+    band_rows = 0;
+    rc_scene_destroy(scene);
+    rc_sensor_destroy(grid);
+    rc_sensor_destroy(sensor);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&m);
+}
+
 /* Every triangle twice (a copy appended: its own vertices, the same
  * values): each hit ties, at the same t, with its copy, and the smaller
  * prim id must win whichever the scan meets first (the offers' tie rule,
@@ -580,6 +682,7 @@ int main(void)
         cmocka_unit_test(test_unfolded_flats),
         cmocka_unit_test(test_coincident_copies),
         cmocka_unit_test(test_edges_on_rows),
+        cmocka_unit_test(test_corners_on_pixels),
         cmocka_unit_test(test_simulate),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -4,6 +4,7 @@
 #ifndef RC_BACKEND_BACKEND_H
 #define RC_BACKEND_BACKEND_H
 
+#include "bvh/scan_raster.h"
 #include "core/context.h"
 #include "core/rmath.h"
 #include "scene/scene.h"
@@ -72,6 +73,13 @@ void rc__write_result(const rc__sim_job *job, uint64_t k, const float dir_s[3], 
  * gives it for hits[i] (a projected scan's). */
 void rc__write_results_run(const rc__sim_job *job, uint64_t base, uint32_t first, uint32_t n, const int *found,
                            const rc__hit *hits, const double *td, const rc__xformf *world);
+
+#if defined(RC__PROJECTED_SCANS)
+/* The sensor's rays as a projected scan's grid (bvh.c): 0 for a model or
+ * grid that has none (O1Dn, OnDn, rays of their own origins, a spherical
+ * grid past a pole). */
+int rc__raster_grid_of(const rc_sensor *s, rc__raster_grid *g);
+#endif
 
 #if defined(RC__HIT_DISTANCES_SSE2)
 /* rc__write_result for n rays of one pose of a one-origin sensor (a packet

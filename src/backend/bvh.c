@@ -65,6 +65,7 @@ typedef struct sim_run {
     rc__raster_grid grid;            /* projected scans: the sensor's grid */
     unsigned char *raster_scratch;   /* projected scans: raster_stride bytes per thread */
     size_t raster_stride;
+    uint32_t raster_band_rows;       /* projected scans: rows a band (the whole scan where it fits) */
 #endif
 } sim_run;
 
@@ -345,63 +346,91 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 #define RC__RASTER_WRITE_RUN 64u
 
 /* One pose of a projected scan (scan_raster.h), then its results, a run at
- * a time. */
+ * a time; band by band of rows where the whole scan's rays would not fit
+ * the scratch (a depth camera's image). */
 static void raster_task(void *user, uint32_t pose, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
     const rc__mesh *mesh = &job->scene->geoms[0].mesh;
+    const uint32_t cols = run->grid.cols;
     unsigned char *scratch = run->raster_scratch + (size_t)thread * run->raster_stride;
     rc__hit hits[RC__RASTER_WRITE_RUN];
     int found[RC__RASTER_WRITE_RUN];
     double td[RC__RASTER_WRITE_RUN];
     rc__xformf world;
-    uint32_t first;
+    uint32_t row0, first;
     rc__job_world_xform(job, pose, &world);
-    rc__raster_scan(mesh, &run->grid, &world, sensor->directions, sensor->range_max, scratch);
-    for (first = 0; first < sensor->rays; first += RC__RASTER_WRITE_RUN) {
-        const uint32_t n = sensor->rays - first < RC__RASTER_WRITE_RUN ? sensor->rays - first : RC__RASTER_WRITE_RUN;
-        rc__raster_hits(mesh, 0u, sensor->rays, &world, sensor->directions, scratch, first, n, hits, found, td);
-        rc__write_results_run(job, (uint64_t)pose * sensor->rays, first, n, found, hits, td, &world);
+    for (row0 = 0; row0 < run->grid.rows; row0 += run->raster_band_rows) {
+        const uint32_t rows = run->grid.rows - row0 < run->raster_band_rows ? run->grid.rows - row0
+                                                                             : run->raster_band_rows;
+        const uint32_t rays = rows * cols, base = row0 * cols;
+        const float *dirs = sensor->directions + (size_t)base * 3u;
+        rc__raster_grid band;
+        rc__raster_band(&run->grid, row0, rows, &band);
+        rc__raster_scan(mesh, &band, &world, dirs, sensor->range_max, scratch);
+        for (first = 0; first < rays; first += RC__RASTER_WRITE_RUN) {
+            const uint32_t n = rays - first < RC__RASTER_WRITE_RUN ? rays - first : RC__RASTER_WRITE_RUN;
+            rc__raster_hits(mesh, 0u, rays, &world, dirs, scratch, first, n, hits, found, td);
+            rc__write_results_run(job, (uint64_t)pose * sensor->rays, base + first, n, found, hits, td, &world);
+        }
     }
 }
 
-/* Sets up a projected scan when it pays: a spherical or cylindrical sensor
- * over a scene of one mesh, no instances, with few triangles against the
- * scan's rays, and the scratch borrowed from the arena's free space (without
- * room the call takes the packets: the same results). Returns 1 when
- * run->raster_scratch was allocated. */
+int rc__raster_grid_of(const rc_sensor *s, rc__raster_grid *g)
+{
+    memset(g, 0, sizeof *g);
+    g->rows = s->rows;
+    g->cols = s->columns;
+    if (s->model == RC_SENSOR_SPHERICAL) {
+        g->phi_min = s->spherical.phi.min;
+        g->phi_inc = s->spherical.phi.increment;
+        g->theta_min = s->spherical.theta.min;
+        g->theta_inc = s->spherical.theta.increment;
+    } else if (s->model == RC_SENSOR_CYLINDRICAL) {
+        g->rows_tan = 1;
+        g->row_cy = s->cylindrical.cy;
+        g->row_fy = s->cylindrical.fy;
+        g->theta_min = s->cylindrical.theta.min;
+        g->theta_inc = s->cylindrical.theta.increment;
+    } else if (s->model == RC_SENSOR_PINHOLE) {
+        g->pinhole = 1;
+        g->optical = s->pinhole.frame == RC_PINHOLE_FRAME_OPTICAL;
+        g->fx = s->pinhole.fx;
+        g->fy = s->pinhole.fy;
+        g->cx = s->pinhole.cx;
+        g->cy = s->pinhole.cy;
+    } else {
+        return 0;
+    }
+    return !s->origins && rc__raster_grid_ok(g);
+}
+
+/* Sets up a projected scan when it pays: a spherical, cylindrical or
+ * pinhole sensor over a scene of one mesh, no instances, with few triangles
+ * against the scan's rays, and the scratch borrowed from the arena's free
+ * space (without room the call takes the packets: the same results).
+ * Returns 1 when run->raster_scratch was allocated. */
 static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
 {
     const rc_scene *scene = job->scene;
     const rc_sensor *s = job->sensor;
     const rc__mesh *mesh;
-    if ((s->model != RC_SENSOR_SPHERICAL && s->model != RC_SENSOR_CYLINDRICAL) || s->origins ||
-        scene->geom_count != 1 || scene->inst_count != 0)
-        return 0;
+    uint32_t band;
+    if (scene->geom_count != 1 || scene->inst_count != 0) return 0;
     mesh = &scene->geoms[0].mesh;
     if (!mesh->leaf_tris || (double)mesh->triangle_count > RC__RASTER_TRIANGLES_PER_RAY * (double)s->rays) return 0;
     /* a call of fewer poses than threads keeps them busy with slices */
     if (run->slices > 1) return 0;
-    memset(&run->grid, 0, sizeof run->grid);
-    run->grid.rows = s->rows;
-    run->grid.cols = s->columns;
-    if (s->model == RC_SENSOR_SPHERICAL) {
-        run->grid.phi_min = s->spherical.phi.min;
-        run->grid.phi_inc = s->spherical.phi.increment;
-        run->grid.theta_min = s->spherical.theta.min;
-        run->grid.theta_inc = s->spherical.theta.increment;
-    } else {
-        run->grid.rows_tan = 1;
-        run->grid.row_cy = s->cylindrical.cy;
-        run->grid.row_fy = s->cylindrical.fy;
-        run->grid.theta_min = s->cylindrical.theta.min;
-        run->grid.theta_inc = s->cylindrical.theta.increment;
-    }
-    if (!rc__raster_grid_ok(&run->grid)) return 0;
-    run->raster_stride = rc__raster_scratch_bytes(s->rays);
-    if (run->raster_stride > RC_SIMULATE_SCRATCH_PER_THREAD) return 0;
+    if (!rc__raster_grid_of(s, &run->grid)) return 0;
+    /* the most rows a band whose scratch fits a thread's share */
+    band = s->rows;
+    while (band > 0 && rc__raster_scratch_bytes(band * s->columns) > RC_SIMULATE_SCRATCH_PER_THREAD)
+        band = rc__raster_scratch_bytes(s->columns) > RC_SIMULATE_SCRATCH_PER_THREAD ? 0 : band / 2u;
+    if (band == 0) return 0;
+    run->raster_band_rows = band;
+    run->raster_stride = rc__raster_scratch_bytes(band * s->columns);
     run->raster_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->raster_stride * ctx->thread_count);
     return run->raster_scratch != NULL;
 }

@@ -1,6 +1,6 @@
 /* Projected scans (scan_raster.h): each triangle of a small mesh meets only
- * the rays of a spherical or cylindrical scan that its bounding cone
- * covers. */
+ * the rays of a spherical or cylindrical scan that its bounding cone covers,
+ * or those of a camera's pixels its image can cover. */
 #include "bvh/scan_raster.h"
 
 #if defined(RC__PROJECTED_SCANS)
@@ -54,8 +54,20 @@ int rc__raster_grid_ok(const rc__raster_grid *g)
     const double half_pi = 1.5707963267948966;
     const double last = g->phi_min + (double)(g->rows - 1u) * g->phi_inc;
     if (g->rows == 0 || g->cols == 0) return 0;
+    if (g->pinhole)
+        return g->fx > 0.0 && g->fy > 0.0 && isfinite(g->fx) && isfinite(g->fy) && isfinite(g->cx) &&
+               isfinite(g->cy);
     if (g->rows_tan) return g->row_fy > 0.0 && isfinite(g->row_fy) && isfinite(g->row_cy);
     return g->phi_min >= -half_pi && g->phi_min <= half_pi && last >= -half_pi && last <= half_pi;
+}
+
+void rc__raster_band(const rc__raster_grid *g, uint32_t row0, uint32_t rows, rc__raster_grid *band)
+{
+    *band = *g;
+    band->rows = rows;
+    band->phi_min = g->phi_min + (double)row0 * g->phi_inc;
+    band->row_cy = g->row_cy - (double)row0;
+    band->cy = g->cy - (double)row0;
 }
 
 /* Rays [from, rays) of the scan prepared as the packets prepare them, kept
@@ -125,6 +137,20 @@ typedef struct raster_tri {
     uint32_t slot;
 } raster_tri;
 
+/* A pinhole grid's camera in the map frame: a point p (relative to the
+ * origin) lies at depth d = F.p, and on the image plane at ox = A.p / d,
+ * oy = B.p / d. The image's rays span [ox_lo, ox_hi] x [oy_lo, oy_hi], here
+ * widened by the margin, far more than a ray's float direction strays from
+ * its pixel's; side[k] . p >= 0 are the four sides of that widened view (the
+ * frustum). */
+typedef struct raster_cam {
+    double F[3], A[3], B[3];
+    double ox_lo, ox_hi, oy_lo, oy_hi;
+    double margin;
+    double side[4][3]; /* as (d, a, b) coefficients */
+    double wside[4][3]; /* the same planes in the map frame */
+} raster_cam;
+
 /* What every test of one scan shares. */
 typedef struct raster_scan {
     const rc__mesh *mesh;
@@ -133,6 +159,7 @@ typedef struct raster_scan {
     const float *r, *org, *dirs;
     double tmax;
     double theta_lo, theta_hi; /* the columns' azimuths' range */
+    raster_cam cam;            /* pinhole grids */
 } raster_scan;
 
 /* The ray's full test, for the double-precision cases. */
@@ -522,6 +549,127 @@ static RC__FORCE_INLINE void raster_four(raster_tri *tris, int n, const raster_s
 }
 #endif
 
+/* The part of polygon in (n corners, (d, a, b) each) on the side k . x >= 0
+ * of a plane through the origin, into out (n + 1 corners at most). */
+static int clip_side(const double in[][3], int n, const double k[3], double out[][3])
+{
+    int i, m = 0;
+    for (i = 0; i < n; ++i) {
+        const double *p = in[i], *q = in[i + 1 < n ? i + 1 : 0];
+        const double fp = k[0] * p[0] + k[1] * p[1] + k[2] * p[2];
+        const double fq = k[0] * q[0] + k[1] * q[1] + k[2] * q[2];
+        if (fp >= 0.0) {
+            memcpy(out[m], p, sizeof out[m]);
+            ++m;
+        }
+        if ((fp >= 0.0) != (fq >= 0.0)) {
+            const double f = fp / (fp - fq);
+            int c;
+            for (c = 0; c < 3; ++c) out[m][c] = p[c] + f * (q[c] - p[c]);
+            ++m;
+        }
+    }
+    return m;
+}
+
+/* First and last index k in [0, count) with lo <= (k - c) / f <= hi (the
+ * image's columns or rows as ox or oy; f > 0), empty (k0 > k1) when none:
+ * widened by a millionth of a pixel and of the coordinate for the rounding
+ * of the products. */
+static void pixel_range(double lo, double hi, double c, double f, uint32_t count, int64_t *k0, int64_t *k1)
+{
+    double a = c + f * lo, b = c + f * hi;
+    a -= 1e-6 * (1.0 + fabs(a));
+    b += 1e-6 * (1.0 + fabs(b));
+    if (!(a <= b) || b < 0.0 || a > (double)count - 1.0) {
+        *k0 = 1;
+        *k1 = 0;
+        return;
+    }
+    a = ceil(a);
+    b = floor(b);
+    *k0 = a < 0.0 ? 0 : (int64_t)a;
+    *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
+}
+
+/* The pixels a triangle can cover: its corners in the camera's (d, a, b),
+ * clipped to the widened frustum, projected; their bounds, clamped to the
+ * view (the clipped corners lie in it, up to rounding), are the rows and
+ * columns tested. A corner at the frustum's apex (d = 0: the triangle
+ * passes through the sensor) has no projection: then every ray. */
+static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_scan *sc)
+{
+    const raster_cam *cam = &sc->cam;
+    const rc__raster_grid *g = sc->g;
+    double poly[2][8][3], olo = INFINITY, ohi = -INFINITY, vlo = INFINITY, vhi = -INFINITY;
+    int n = 3, k, c, cur = 0;
+    int64_t i0, i1, j0, j1, i;
+    for (c = 0; c < 3; ++c) {
+        const double x = tri->rel[c][0], y = tri->rel[c][1], z = tri->rel[c][2];
+        poly[0][c][0] = cam->F[0] * x + cam->F[1] * y + cam->F[2] * z;
+        poly[0][c][1] = cam->A[0] * x + cam->A[1] * y + cam->A[2] * z;
+        poly[0][c][2] = cam->B[0] * x + cam->B[1] * y + cam->B[2] * z;
+    }
+    for (k = 0; k < 4 && n > 0; ++k) {
+        n = clip_side((const double(*)[3])poly[cur], n, cam->side[k], poly[cur ^ 1]);
+        cur ^= 1;
+    }
+    if (n == 0) return;
+    for (c = 0; c < n; ++c) {
+        const double d = poly[cur][c][0];
+        double ox, oy;
+        if (!(d > 0.0)) {
+            olo = vlo = -INFINITY;
+            ohi = vhi = INFINITY;
+            break;
+        }
+        ox = poly[cur][c][1] / d;
+        oy = poly[cur][c][2] / d;
+        if (!(ox == ox) || !(oy == oy)) { /* (inf / inf from a corner far out) */
+            olo = vlo = -INFINITY;
+            ohi = vhi = INFINITY;
+            break;
+        }
+        olo = ox < olo ? ox : olo;
+        ohi = ox > ohi ? ox : ohi;
+        vlo = oy < vlo ? oy : vlo;
+        vhi = oy > vhi ? oy : vhi;
+    }
+    /* a ray strays from its pixel's direction by less than the margin:
+     * the pixels of the bounds widened by it */
+    olo = olo - cam->margin > cam->ox_lo ? olo - cam->margin : cam->ox_lo;
+    ohi = ohi + cam->margin < cam->ox_hi ? ohi + cam->margin : cam->ox_hi;
+    vlo = vlo - cam->margin > cam->oy_lo ? vlo - cam->margin : cam->oy_lo;
+    vhi = vhi + cam->margin < cam->oy_hi ? vhi + cam->margin : cam->oy_hi;
+    pixel_range(olo, ohi, g->cx, g->fx, g->cols, &j0, &j1);
+    pixel_range(vlo, vhi, g->cy, g->fy, g->rows, &i0, &i1);
+    if (j0 > j1) return;
+    for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+}
+
+/* 1 when some point of the box (child c of n, the map frame) may lie in the
+ * camera's widened view and within tmax of the origin. */
+static RC__FORCE_INLINE int pinhole_box_visible(const raster_scan *sc, const rc__wnode *n, int c)
+{
+    double m[3], h[3], h2 = 0.0, m2 = 0.0;
+    int k, p;
+    for (k = 0; k < 3; ++k) {
+        const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
+        m[k] = 0.5 * (lo + hi) - sc->org[k];
+        h[k] = 0.5 * (hi - lo);
+        h2 += h[k] * h[k];
+        m2 += m[k] * m[k];
+    }
+    /* the box's nearest point is no nearer than its bounding sphere's */
+    if (sqrt(m2) - sqrt(h2) > sc->tmax * (1.0 + 1e-6)) return 0;
+    for (p = 0; p < 4; ++p) {
+        const double *w = sc->cam.wside[p];
+        const double reach = fabs(w[0]) * h[0] + fabs(w[1]) * h[1] + fabs(w[2]) * h[2];
+        if (w[0] * m[0] + w[1] * m[1] + w[2] * m[2] + reach < 0.0) return 0;
+    }
+    return 1;
+}
+
 /* Triangles [first, first + count) of the leaf order. */
 static RC__FORCE_INLINE void raster_slots(const raster_scan *sc, uint32_t first, uint32_t count)
 {
@@ -544,6 +692,10 @@ static RC__FORCE_INLINE void raster_slots(const raster_scan *sc, uint32_t first,
         tri->slot = s;
         /* zero area: never hit (the tests skip what a commit folded) */
         if (!mesh->flats_folded && rc__tri_zero_area(tri->v[0], tri->v[1], tri->v[2])) continue;
+        if (sc->g->pinhole) {
+            raster_pinhole(tri, sc);
+            continue;
+        }
 #if defined(RC__CONE_LANES)
         if (++n == 4) {
             raster_four(tris, n, sc);
@@ -574,15 +726,19 @@ static RC__FORCE_INLINE void raster_tree(const raster_scan *sc)
             rc__cone cone;
             int k;
             if (n->child[c] == RC__WIDE_EMPTY) continue;
-            for (k = 0; k < 3; ++k) {
-                const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
-                m[k] = 0.5 * (lo + hi) - sc->org[k];
-                h2 += 0.25 * (hi - lo) * (hi - lo);
+            if (sc->g->pinhole) {
+                if (!pinhole_box_visible(sc, n, c)) continue;
+            } else {
+                for (k = 0; k < 3; ++k) {
+                    const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
+                    m[k] = 0.5 * (lo + hi) - sc->org[k];
+                    h2 += 0.25 * (hi - lo) * (hi - lo);
+                }
+                rad = sqrt(h2) * (1.0 + 1e-9);
+                if (rc__cone_place(sc->g, sc->r, sc->tmax, m, rad,
+                                   sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) + rad, &cone) == RC__CONE_NONE)
+                    continue;
             }
-            rad = sqrt(h2) * (1.0 + 1e-9);
-            if (rc__cone_place(sc->g, sc->r, sc->tmax, m, rad, sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) + rad,
-                               &cone) == RC__CONE_NONE)
-                continue;
             if (n->count[c])
                 raster_slots(sc, n->child[c], n->count[c]);
             else /* at most 3 a level stay: the bound holds (wide depth <= the binary tree's) */
@@ -630,6 +786,44 @@ static void plane(const float *const v[3], const double od[3], double n[3], doub
     *w = n[0] * (ax - od[0]) + n[1] * (ay - od[1]) + n[2] * (az - od[2]);
 }
 
+/* The camera of a pinhole grid turned by r (raster_cam). The margin is
+ * 1e-5 (1 + ox^2 + oy^2) at the view's widest, where the rays' float
+ * directions (their unit vectors, the turn) stray from the pixels' by about
+ * 1e-7 as much (on a long lens, fx 2000, a hundredth of a pixel). */
+static void camera_setup(const rc__raster_grid *g, const float r[9], raster_cam *cam)
+{
+    const int f = g->optical ? 2 : 0, a = g->optical ? 0 : 1, b = g->optical ? 1 : 2;
+    const double sa = g->optical ? 1.0 : -1.0; /* body frame: (1, -ox, -oy) */
+    double mx, my, m;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        cam->F[k] = (double)r[3 * k + f];
+        cam->A[k] = sa * (double)r[3 * k + a];
+        cam->B[k] = sa * (double)r[3 * k + b];
+    }
+    cam->ox_lo = -g->cx / g->fx;
+    cam->ox_hi = ((double)g->cols - 1.0 - g->cx) / g->fx;
+    cam->oy_lo = -g->cy / g->fy;
+    cam->oy_hi = ((double)g->rows - 1.0 - g->cy) / g->fy;
+    mx = fabs(cam->ox_lo) > fabs(cam->ox_hi) ? fabs(cam->ox_lo) : fabs(cam->ox_hi);
+    my = fabs(cam->oy_lo) > fabs(cam->oy_hi) ? fabs(cam->oy_lo) : fabs(cam->oy_hi);
+    m = 1e-5 * (1.0 + mx * mx + my * my);
+    cam->margin = m;
+    cam->ox_lo -= m;
+    cam->ox_hi += m;
+    cam->oy_lo -= m;
+    cam->oy_hi += m;
+    cam->side[0][0] = -cam->ox_lo, cam->side[0][1] = 1.0, cam->side[0][2] = 0.0;
+    cam->side[1][0] = cam->ox_hi, cam->side[1][1] = -1.0, cam->side[1][2] = 0.0;
+    cam->side[2][0] = -cam->oy_lo, cam->side[2][1] = 0.0, cam->side[2][2] = 1.0;
+    cam->side[3][0] = cam->oy_hi, cam->side[3][1] = 0.0, cam->side[3][2] = -1.0;
+    for (k = 0; k < 4; ++k) {
+        int j;
+        for (j = 0; j < 3; ++j)
+            cam->wside[k][j] = cam->side[k][0] * cam->F[j] + cam->side[k][1] * cam->A[j] + cam->side[k][2] * cam->B[j];
+    }
+}
+
 void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__xformf *world, const float *dirs,
                      float tmax, void *scratch)
 {
@@ -651,6 +845,7 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
         sc.theta_lo = last < g->theta_min ? last : g->theta_min;
         sc.theta_hi = last < g->theta_min ? g->theta_min : last;
     }
+    if (g->pinhole) camera_setup(g, world->r, &sc.cam);
     for (i = 0; i < rays; ++i) {
         sc.rr.bt[i] = tmax;
         sc.rr.bs[i] = RC_INVALID_ID;

@@ -1,15 +1,19 @@
-/* Projected scans: a spherical or cylindrical scan of a small mesh traced
- * triangle by triangle instead of ray by ray. Each triangle's bounding
- * sphere, seen from the sensor, covers a cone; the rows and columns of the
- * scan's grid that can fall in that cone are found from the grid's angles,
- * and only those rays run the watertight test against the triangle. The
- * mesh's tree is walked once a scan, only to pass over boxes no row meets,
- * so on a mesh with fewer triangles than the scan has rays this costs a few
- * tests a ray where the packets pay their node visits (docs/architecture.md,
- * "Projected scans"). The cone is widened beyond every rounding of the test,
- * and each test is rc__tri_intersect_any_area's operations in its order (its
- * rare cases run that function itself), so every ray gets the nearest hit,
- * tie rule included, that any traversal of the tree gives: the same bits. */
+/* Projected scans: a spherical, cylindrical or pinhole scan of a small mesh
+ * traced triangle by triangle instead of ray by ray. A spinning sensor's
+ * rays are found from angles: each triangle's bounding sphere, seen from the
+ * sensor, covers a cone, and the rows and columns of the scan's grid that
+ * can fall in that cone are found from the grid's angles. A camera's are
+ * found on its image: the triangle, clipped to the view's frustum, projects
+ * to a polygon whose corners bound the pixels it can cover. Only those rays
+ * run the watertight test against the triangle. The mesh's tree is walked
+ * once a scan, only to pass over boxes no row meets (or outside the
+ * camera's view), so on a mesh with fewer triangles than the scan has rays
+ * this costs a few tests a ray where the packets pay their node visits
+ * (docs/architecture.md, "Projected scans"). Cones, clip planes and pixel
+ * bounds are widened beyond every rounding of the test, and each test is
+ * rc__tri_intersect_any_area's operations in its order (its rare cases run
+ * that function itself), so every ray gets the nearest hit, tie rule
+ * included, that any traversal of the tree gives: the same bits. */
 #ifndef RC_BVH_SCAN_RASTER_H
 #define RC_BVH_SCAN_RASTER_H
 
@@ -30,20 +34,32 @@
  * (elevation) and theta_min + j * theta_inc (azimuth), x forward, z up. A
  * cylindrical one (rows_tan 1) has the same columns, and row v at the
  * elevation atan((row_cy - v) / row_fy), row_fy > 0 (rc_cylindrical_desc):
- * phi_min and phi_inc are then unused. */
+ * phi_min and phi_inc are then unused. A pinhole one (pinhole 1, rows the
+ * image's height, cols its width) has pixel (v, u) looking along optical
+ * (ox, oy, 1), ox = (u - cx) / fx, oy = (v - cy) / fy, fx, fy > 0: the
+ * sensor frame's (1, -ox, -oy), or (ox, oy, 1) itself when optical is 1
+ * (rc_pinhole_desc); only those fields are used. A band of rows [r0, r0 + n)
+ * of any of them is the grid rc__raster_band gives. */
 typedef struct rc__raster_grid {
     uint32_t rows, cols;
     double phi_min, phi_inc;
     double theta_min, theta_inc;
     int rows_tan;
     double row_cy, row_fy;
+    int pinhole, optical;
+    double fx, fy, cx, cy;
     /* 1 / phi_inc and 1 / theta_inc (0 for 0): rc__raster_scan sets them */
     double phi_inv, theta_inv;
 } rc__raster_grid;
 
+/* Rows [row0, row0 + rows) of g as a grid of their own: its ray (i, j) is
+ * g's (row0 + i, j), its rays the sensor's directions from row0 * cols on. */
+void rc__raster_band(const rc__raster_grid *g, uint32_t row0, uint32_t rows, rc__raster_grid *band);
+
 /* 1 when every row's elevation lies within [-pi/2, pi/2] (a cone's rows are
  * found from its elevations, which take only that range): always so for a
- * cylindrical grid with row_fy > 0. */
+ * cylindrical grid with row_fy > 0. A pinhole grid needs finite intrinsics,
+ * fx and fy positive. */
 int rc__raster_grid_ok(const rc__raster_grid *g);
 
 /* Scratch bytes rc__raster_scan needs for a scan of `rays` rays (16-byte
