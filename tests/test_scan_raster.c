@@ -19,7 +19,7 @@
  * tree, and with every triangle twice (ties); a long lens on a wall of
  * tiny triangles whose corners lie on its pixels' rays; and the placement's
  * atan2 against libm's. Then through rc_simulate (a VLP-16, the cylindrical
- * panorama and a camera): every attribute of a call that takes the projected scan equals,
+ * panorama and the first camera): every attribute of a call that takes the projected scan equals,
  * byte for byte, a context without arena room for its scratch (the packets),
  * on 1 and 3 threads. */
 #include <math.h>
@@ -570,9 +570,9 @@ static rc_sensor *fill_arena(rc_context *ctx, size_t left)
 }
 
 /* Every attribute of calls with ctx (room for the projected scan's scratch)
- * and tight (none: the packets), byte for byte: a VLP-16, or the first
- * cylindrical grid. */
-static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads, int cylindrical)
+ * and tight (none: the packets), byte for byte: a VLP-16 (kind 0), the
+ * first cylindrical grid (1) or the first camera, 0.8 to 4 m (2). */
+static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads, int kind)
 {
     const uint32_t attrs = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_POINTS | RC_ATTR_NORMALS | RC_ATTR_PRIM_IDS |
                            RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS;
@@ -583,9 +583,12 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m,
     rct_buffers ba, bb;
     uint32_t p, ninf = 0, pinf = 0;
     uint64_t i;
-    if (cylindrical) {
+    if (kind == 1) {
         a = cyl_sensor(ctx, &cyls[0], 0.5f, 130.0f, NULL);
         b = cyl_sensor(tight, &cyls[0], 0.5f, 130.0f, NULL);
+    } else if (kind == 2) {
+        a = cam_sensor(ctx, &cams[0], 0.8f, 4.0f, NULL);
+        b = cam_sensor(tight, &cams[0], 0.8f, 4.0f, NULL);
     } else {
         RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &a));
         RCT_OK(tight, rc_sensor_create_preset(tight, RC_PRESET_VELODYNE_VLP16, &b));
@@ -629,7 +632,8 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m,
         pinf += ba.res.ranges[i] > 0.0f && isinf(ba.res.ranges[i]);
     }
     /* the box room of compare_simulate has both: walls nearer than
-     * range_min (0.5 m) and openings with nothing within range */
+     * range_min (0.5 m; the camera's 0.8 m) and openings or walls with
+     * nothing within range */
     assert_true(ninf > 0 && pinf > 0 && ninf + pinf < ba.n / 2u);
     rct_buffers_free(&ba);
     rct_buffers_free(&bb);
@@ -659,11 +663,11 @@ static void test_simulate(void **state)
     memmove(room.indices, room.indices + 6u, (room.triangle_count - 2u) * 3u * sizeof(uint32_t));
     room.triangle_count -= 2u;
     for (threads = 1; threads <= 3; threads += 2) {
-        int cylindrical;
-        for (cylindrical = 0; cylindrical < 2; ++cylindrical) {
+        int kind;
+        for (kind = 0; kind < 3; ++kind) {
             rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
             rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
-            compare_calls(ctx, tight, &room, threads, cylindrical);
+            compare_calls(ctx, tight, &room, threads, kind);
             rc_context_destroy(ctx);
             rc_context_destroy(tight);
         }
