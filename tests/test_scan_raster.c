@@ -635,6 +635,13 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m,
      * range_min (0.5 m; the camera's 0.8 m) and openings or walls with
      * nothing within range */
     assert_true(ninf > 0 && pinf > 0 && ninf + pinf < ba.n / 2u);
+    /* one pose: on 3 threads its scan is cut into bands of rows, a task
+     * each (the packets' slices) */
+    RCT_OK(ctx, rc_simulate(ctx, sa, a, poses + 3, 1u, &ba.res));
+    RCT_OK(tight, rc_simulate(tight, sb, b, poses + 3, 1u, &bb.res));
+    assert_memory_equal(ba.res.ranges, bb.res.ranges, a->rays * sizeof(float));
+    assert_memory_equal(ba.res.prim_ids, bb.res.prim_ids, a->rays * sizeof(uint32_t));
+    assert_memory_equal(ba.res.normals, bb.res.normals, a->rays * 3u * sizeof(float));
     rct_buffers_free(&ba);
     rct_buffers_free(&bb);
     rc_sensor_destroy(a);

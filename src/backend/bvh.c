@@ -66,6 +66,7 @@ typedef struct sim_run {
     unsigned char *raster_scratch;   /* projected scans: raster_stride bytes per thread */
     size_t raster_stride;
     uint32_t raster_band_rows;       /* projected scans: rows a band (the whole scan where it fits) */
+    uint32_t raster_bands;           /* projected scans: bands a scan (tasks a pose) */
 #endif
 } sim_run;
 
@@ -345,36 +346,34 @@ static void trace_ordered_task(void *user, uint32_t task, uint32_t thread)
 /* rays a projected scan hands the writer at a time */
 #define RC__RASTER_WRITE_RUN 64u
 
-/* One pose of a projected scan (scan_raster.h), then its results, a run at
- * a time; band by band of rows where the whole scan's rays would not fit
- * the scratch (a depth camera's image). */
-static void raster_task(void *user, uint32_t pose, uint32_t thread)
+/* One band of rows of one pose's projected scan (scan_raster.h), then its
+ * results, a run at a time. A scan takes several bands where its rays would
+ * not fit a thread's scratch at once (a depth camera's image), or where a
+ * call of few poses spreads each over the threads. */
+static void raster_task(void *user, uint32_t task, uint32_t thread)
 {
     const sim_run *run = (const sim_run *)user;
     const rc__sim_job *job = run->job;
     const rc_sensor *sensor = job->sensor;
     const rc__mesh *mesh = &job->scene->geoms[0].mesh;
-    const uint32_t cols = run->grid.cols;
+    const uint32_t pose = task / run->raster_bands, row0 = (task % run->raster_bands) * run->raster_band_rows;
+    const uint32_t rows = run->grid.rows - row0 < run->raster_band_rows ? run->grid.rows - row0 : run->raster_band_rows;
+    const uint32_t rays = rows * run->grid.cols, base = row0 * run->grid.cols;
+    const float *dirs = sensor->directions + (size_t)base * 3u;
     unsigned char *scratch = run->raster_scratch + (size_t)thread * run->raster_stride;
     rc__hit hits[RC__RASTER_WRITE_RUN];
     int found[RC__RASTER_WRITE_RUN];
     double td[RC__RASTER_WRITE_RUN];
     rc__xformf world;
-    uint32_t row0, first;
+    rc__raster_grid band;
+    uint32_t first;
     rc__job_world_xform(job, pose, &world);
-    for (row0 = 0; row0 < run->grid.rows; row0 += run->raster_band_rows) {
-        const uint32_t rows = run->grid.rows - row0 < run->raster_band_rows ? run->grid.rows - row0
-                                                                             : run->raster_band_rows;
-        const uint32_t rays = rows * cols, base = row0 * cols;
-        const float *dirs = sensor->directions + (size_t)base * 3u;
-        rc__raster_grid band;
-        rc__raster_band(&run->grid, row0, rows, &band);
-        rc__raster_scan(mesh, &band, &world, dirs, sensor->range_max, scratch);
-        for (first = 0; first < rays; first += RC__RASTER_WRITE_RUN) {
-            const uint32_t n = rays - first < RC__RASTER_WRITE_RUN ? rays - first : RC__RASTER_WRITE_RUN;
-            rc__raster_hits(mesh, 0u, rays, &world, dirs, scratch, first, n, hits, found, td);
-            rc__write_results_run(job, (uint64_t)pose * sensor->rays, base + first, n, found, hits, td, &world);
-        }
+    rc__raster_band(&run->grid, row0, rows, &band);
+    rc__raster_scan(mesh, &band, &world, dirs, sensor->range_max, scratch);
+    for (first = 0; first < rays; first += RC__RASTER_WRITE_RUN) {
+        const uint32_t n = rays - first < RC__RASTER_WRITE_RUN ? rays - first : RC__RASTER_WRITE_RUN;
+        rc__raster_hits(mesh, 0u, rays, &world, dirs, scratch, first, n, hits, found, td);
+        rc__write_results_run(job, (uint64_t)pose * sensor->rays, base + first, n, found, hits, td, &world);
     }
 }
 
@@ -421,15 +420,17 @@ static int plan_raster(rc_context *ctx, const rc__sim_job *job, sim_run *run)
     if (scene->geom_count != 1 || scene->inst_count != 0) return 0;
     mesh = &scene->geoms[0].mesh;
     if (!mesh->leaf_tris || (double)mesh->triangle_count > RC__RASTER_TRIANGLES_PER_RAY * (double)s->rays) return 0;
-    /* a call of fewer poses than threads keeps them busy with slices */
-    if (run->slices > 1) return 0;
     if (!rc__raster_grid_of(s, &run->grid)) return 0;
     /* the most rows a band whose scratch fits a thread's share */
     band = s->rows;
     while (band > 0 && rc__raster_scratch_bytes(band * s->columns) > RC_SIMULATE_SCRATCH_PER_THREAD)
         band = rc__raster_scratch_bytes(s->columns) > RC_SIMULATE_SCRATCH_PER_THREAD ? 0 : band / 2u;
     if (band == 0) return 0;
+    /* a call of few poses cut into slices (bvh_simulate): as many bands */
+    if (run->slices > 1 && (s->rows + run->slices - 1u) / run->slices < band)
+        band = (s->rows + run->slices - 1u) / run->slices;
     run->raster_band_rows = band;
+    run->raster_bands = (s->rows + band - 1u) / band;
     run->raster_stride = rc__raster_scratch_bytes(band * s->columns);
     run->raster_scratch = (unsigned char *)rc__arena_alloc(&ctx->arena, run->raster_stride * ctx->thread_count);
     return run->raster_scratch != NULL;
@@ -519,7 +520,7 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     run.tiles_per_slice = (run.tiles + run.slices - 1u) / run.slices;
 #if defined(RC__PROJECTED_SCANS) && !defined(RANGECAST_NO_PACKETS)
     if (plan_raster(ctx, job, &run)) {
-        rc__pool_run(ctx->pool, job->pose_count, raster_task, &run);
+        rc__pool_run(ctx->pool, job->pose_count * run.raster_bands, raster_task, &run);
         rc__arena_free(&ctx->arena, run.raster_scratch);
         return RC_OK;
     }
