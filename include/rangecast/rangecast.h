@@ -848,13 +848,14 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * RC_SIMULATE_SCRATCH_PER_THREAD a thread, shown in rc_memory_stats.arena_peak)
  * to trace the call's tiles in the order of the map rather than scan by scan
  * (faster on maps the cache cannot hold); without that room they run scan by
- * scan. The built-in backend, for a spherical or cylindrical sensor on a
- * scene of one mesh with at most one triangle per ray of the scan and no
- * instances, in a call of whole scans for every thread (one thread, or at
- * least four scans a thread), borrows 21 bytes a ray a thread (at most
- * RC_SIMULATE_SCRATCH_PER_THREAD) to trace each scan triangle by triangle
- * instead (docs/architecture.md, "Projected scans"); without the room it
- * takes the tiles. The results are the same bits either way. */
+ * scan. The built-in backend, for a spherical, cylindrical or pinhole sensor
+ * on a scene of one mesh with at most one triangle per ray of the scan and no
+ * instances, borrows 21 bytes a ray a thread (at most
+ * RC_SIMULATE_SCRATCH_PER_THREAD: a larger scan goes in bands of rows) to
+ * trace each scan triangle by triangle instead (docs/architecture.md,
+ * "Projected scans"); a call of fewer than four scans a thread cuts each into
+ * bands of rows for the threads. Without the room it takes the tiles. The
+ * results are the same bits either way. */
 RC_API rc_status rc_simulate(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor,
                              const rc_pose *poses, uint32_t pose_count, const rc_results *results);
 
