@@ -592,6 +592,10 @@ static void pixel_range(double lo, double hi, double c, double f, uint32_t count
     *k1 = b > (double)count - 1.0 ? (int64_t)count - 1 : (int64_t)b;
 }
 
+/* Columns a triangle spans (in groups of lanes, twice over) before its
+ * columns are found row by row */
+#define RC__RASTER_SPAN_COLUMNS 8
+
 /* The pixels a triangle can cover: its corners in the camera's (d, a, b),
  * clipped to the widened frustum, projected; their bounds, clamped to the
  * view (the clipped corners lie in it, up to rounding), are the rows and
@@ -601,8 +605,8 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
 {
     const raster_cam *cam = &sc->cam;
     const rc__raster_grid *g = sc->g;
-    double poly[2][8][3], olo = INFINITY, ohi = -INFINITY, vlo = INFINITY, vhi = -INFINITY;
-    int n = 3, k, c, cur = 0;
+    double poly[2][8][3], px[8], py[8], olo = INFINITY, ohi = -INFINITY, vlo = INFINITY, vhi = -INFINITY;
+    int n = 3, k, c, cur = 0, projected = 1;
     int64_t i0, i1, j0, j1, i;
     for (c = 0; c < 3; ++c) {
         const double x = tri->rel[c][0], y = tri->rel[c][1], z = tri->rel[c][2];
@@ -621,13 +625,15 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
         if (!(d > 0.0)) {
             olo = vlo = -INFINITY;
             ohi = vhi = INFINITY;
+            projected = 0;
             break;
         }
-        ox = poly[cur][c][1] / d;
-        oy = poly[cur][c][2] / d;
+        ox = px[c] = poly[cur][c][1] / d;
+        oy = py[c] = poly[cur][c][2] / d;
         if (!(ox == ox) || !(oy == oy)) { /* (inf / inf from a corner far out) */
             olo = vlo = -INFINITY;
             ohi = vhi = INFINITY;
+            projected = 0;
             break;
         }
         olo = ox < olo ? ox : olo;
@@ -644,7 +650,40 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
     pixel_range(olo, ohi, g->cx, g->fx, g->cols, &j0, &j1);
     pixel_range(vlo, vhi, g->cy, g->fy, g->rows, &i0, &i1);
     if (j0 > j1) return;
-    for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+    if (!projected || i0 == i1 || j1 - j0 < 2 * RC__RASTER_SPAN_COLUMNS) {
+        for (i = i0; i <= i1; ++i) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+        return;
+    }
+    /* a large triangle: row by row, the columns the polygon reaches within
+     * the margin of the row's oy (a convex polygon's extent there lies at
+     * its edges' points in that band) */
+    for (i = i0; i <= i1; ++i) {
+        const double oy = ((double)i - g->cy) / g->fy, ylo = oy - cam->margin, yhi = oy + cam->margin;
+        double a = INFINITY, b = -INFINITY;
+        for (c = 0; c < n; ++c) {
+            const int e = c + 1 < n ? c + 1 : 0;
+            const double lo = py[c] < py[e] ? py[c] : py[e], hi = py[c] < py[e] ? py[e] : py[c];
+            double xa, xb;
+            if (hi < ylo || lo > yhi) continue;
+            if (py[e] == py[c]) {
+                xa = px[c];
+                xb = px[e];
+            } else {
+                const double slope = (px[e] - px[c]) / (py[e] - py[c]);
+                xa = px[c] + ((lo > ylo ? lo : ylo) - py[c]) * slope;
+                xb = px[c] + ((hi < yhi ? hi : yhi) - py[c]) * slope;
+            }
+            a = xa < a ? xa : a;
+            a = xb < a ? xb : a;
+            b = xa > b ? xa : b;
+            b = xb > b ? xb : b;
+        }
+        if (!(a <= b)) continue;
+        a = a - cam->margin > cam->ox_lo ? a - cam->margin : cam->ox_lo;
+        b = b + cam->margin < cam->ox_hi ? b + cam->margin : cam->ox_hi;
+        pixel_range(a, b, g->cx, g->fx, g->cols, &j0, &j1);
+        if (j0 <= j1) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+    }
 }
 
 /* 1 when some point of the box (child c of n, the map frame) may lie in the
