@@ -897,31 +897,37 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
         raster_all_base(&sc);
 }
 
-/* The distance refinement keeps the plane while neighbouring rays share
- * their triangle. */
-void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
-                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td)
+/* The hits of rays [first, first + n), and their distances refined: the
+ * plane is kept while neighbouring rays share their triangle, and four rays
+ * on one triangle are refined at once in lanes of doubles where there are
+ * any (the division a ray was half the time of the scalar loop, its latency
+ * in the way of every result). Each lane repeats the scalar refinement's
+ * operations in their order. */
+static RC__FORCE_INLINE void hits_run(const rc__mesh *mesh, uint32_t geom, const rc__xformf *world, const float *dirs,
+                                      const raster_rays *rr, uint32_t first, uint32_t n, rc__hit *hits, int *found,
+                                      double *td)
 {
     const double *r = world->rd;
-    const uint32_t *refs = mesh->bvh.refs, *bs;
-    const float *bt, *p = dirs + (size_t)first * 3u;
-    raster_rays rr;
+    const uint32_t *refs = mesh->bvh.refs, *bs = rr->bs + first;
+    const float *bt = rr->bt + first, *p = dirs + (size_t)first * 3u;
     uint32_t i, last = RC_INVALID_ID;
     double nv[3] = {0.0, 0.0, 0.0}, w = 0.0;
-    scratch_split(scratch, rays, &rr);
-    bs = rr.bs + first;
-    bt = rr.bt + first;
-    for (i = 0; i < n; ++i, p += 3) {
+    for (i = 0; i < n; ++i) {
         const uint32_t slot = bs[i];
-        const float t = bt[i];
-        double dx, dy, dz, dn, q;
-        hits[i].t = t;
+        hits[i].t = bt[i];
         hits[i].geom = hits[i].prim = hits[i].inst = hits[i].slot = RC_INVALID_ID;
         found[i] = slot != RC_INVALID_ID;
         if (slot == RC_INVALID_ID) continue;
         hits[i].prim = refs[slot];
         hits[i].geom = geom;
         hits[i].slot = slot;
+    }
+    for (i = 0; i < n;) {
+        const uint32_t slot = bs[i];
+        if (slot == RC_INVALID_ID) {
+            ++i;
+            continue;
+        }
         if (slot != last) {
             const uint32_t *ix = mesh->leaf_tris + (size_t)slot * 3u;
             const float *v[3];
@@ -930,13 +936,57 @@ void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const r
             plane(v, world->td, nv, &w);
             last = slot;
         }
-        dx = r[0] * p[0] + r[1] * p[1] + r[2] * p[2];
-        dy = r[3] * p[0] + r[4] * p[1] + r[5] * p[2];
-        dz = r[6] * p[0] + r[7] * p[1] + r[8] * p[2];
-        dn = nv[0] * dx + nv[1] * dy + nv[2] * dz;
-        q = w / dn;
-        td[i] = dn == 0.0 || !isfinite(q) ? (double)t : q;
+#if defined(RC__CONE_LANES)
+        if (i + 4u <= n && bs[i + 1u] == slot && bs[i + 2u] == slot && bs[i + 3u] == slot) {
+            const float *d = p + (size_t)i * 3u;
+            const rc__v4d x = {d[0], d[3], d[6], d[9]}, y = {d[1], d[4], d[7], d[10]}, z = {d[2], d[5], d[8], d[11]};
+            const rc__v4d dx = r[0] * x + r[1] * y + r[2] * z;
+            const rc__v4d dy = r[3] * x + r[4] * y + r[5] * z;
+            const rc__v4d dz = r[6] * x + r[7] * y + r[8] * z;
+            const rc__v4d dn = nv[0] * dx + nv[1] * dy + nv[2] * dz;
+            const rc__v4d t = {bt[i], bt[i + 1u], bt[i + 2u], bt[i + 3u]};
+            rc__v4d q = w / dn;
+            /* dn == 0 gives an infinite or NaN q: then the float t, as below */
+            q = rc__v4d_select(q - q == rc__v4d_splat(0.0), q, t);
+            memcpy(td + i, &q, sizeof q);
+            i += 4u;
+            continue;
+        }
+#endif
+        {
+            const float *d = p + (size_t)i * 3u;
+            const double dx = r[0] * d[0] + r[1] * d[1] + r[2] * d[2];
+            const double dy = r[3] * d[0] + r[4] * d[1] + r[5] * d[2];
+            const double dz = r[6] * d[0] + r[7] * d[1] + r[8] * d[2];
+            const double dn = nv[0] * dx + nv[1] * dy + nv[2] * dz, q = w / dn;
+            td[i] = dn == 0.0 || !isfinite(q) ? (double)bt[i] : q;
+            ++i;
+        }
     }
+}
+
+#if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__CONE_LANES)
+static __attribute__((target("avx2"), noinline)) void hits_run_avx2(const rc__mesh *mesh, uint32_t geom,
+                                                                  const rc__xformf *world, const float *dirs,
+                                                                  const raster_rays *rr, uint32_t first, uint32_t n,
+                                                                  rc__hit *hits, int *found, double *td)
+{
+    hits_run(mesh, geom, world, dirs, rr, first, n, hits, found, td);
+}
+#endif
+
+void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
+                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td)
+{
+    raster_rays rr;
+    scratch_split(scratch, rays, &rr);
+#if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__CONE_LANES)
+    if (rc__leaf4_have_avx2()) {
+        hits_run_avx2(mesh, geom, world, dirs, &rr, first, n, hits, found, td);
+        return;
+    }
+#endif
+    hits_run(mesh, geom, world, dirs, &rr, first, n, hits, found, td);
 }
 #else
 typedef int rc__scan_raster_left_out; /* ISO C: no empty translation unit */
