@@ -205,6 +205,7 @@ static RC__FORCE_INLINE void test_ray(const raster_tri *tri, const raster_scan *
 #define RC__RASTER_LANES 8u
 typedef float rc__v8f __attribute__((vector_size(32)));
 typedef int32_t rc__v8i __attribute__((vector_size(32)));
+typedef unsigned char rc__v8b __attribute__((vector_size(8)));
 
 /* (no vector arguments or returns: outside the AVX2 build those change the
  * calling convention, and gcc says so) */
@@ -293,7 +294,6 @@ static RC__FORCE_INLINE uint32_t rays_fill8(uint32_t rays, const float r[9], con
         float in[3][8];
         rc__v8f x, y, z, dx, dy, dz, ax, ay, az, m;
         rc__v8i is1, is2, neg, code;
-        int32_t codes[8];
         for (k = 0; k < RC__RASTER_LANES; ++k) {
             in[0][k] = dirs[(size_t)(at + k) * 3u];
             in[1][k] = dirs[(size_t)(at + k) * 3u + 1u];
@@ -329,8 +329,11 @@ static RC__FORCE_INLINE uint32_t rays_fill8(uint32_t rays, const float r[9], con
         /* kx | ky << 2 | kz << 4 */
         code = select8i(is2, select8i(neg, splat8i(33), splat8i(36)),
                         select8i(is1, select8i(neg, splat8i(24), splat8i(18)), select8i(neg, splat8i(6), splat8i(9))));
-        memcpy(codes, &code, sizeof codes);
-        for (k = 0; k < RC__RASTER_LANES; ++k) rr->axes[at + k] = (unsigned char)codes[k];
+        {
+            /* the eight codes narrowed to bytes in lanes, stored at once */
+            const rc__v8b bytes = __builtin_convertvector(code, rc__v8b);
+            memcpy(rr->axes + at, &bytes, sizeof bytes);
+        }
     }
     return at;
 }
