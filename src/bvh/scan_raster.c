@@ -663,6 +663,8 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
     for (i = i0; i <= i1; ++i) {
         const double oy = ((double)i - g->cy) / g->fy, ylo = oy - cam->margin, yhi = oy + cam->margin;
         double a = INFINITY, b = -INFINITY;
+        int64_t r0 = j0, r1 = j1;
+        int odd = 0;
         for (c = 0; c < n; ++c) {
             const int e = c + 1 < n ? c + 1 : 0;
             const double lo = py[c] < py[e] ? py[c] : py[e], hi = py[c] < py[e] ? py[e] : py[c];
@@ -676,16 +678,20 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
                 xa = px[c] + ((lo > ylo ? lo : ylo) - py[c]) * slope;
                 xb = px[c] + ((hi < yhi ? hi : yhi) - py[c]) * slope;
             }
+            odd |= !(xa == xa) || !(xb == xb);
             a = xa < a ? xa : a;
             a = xb < a ? xb : a;
             b = xa > b ? xa : b;
             b = xb > b ? xb : b;
         }
-        if (!(a <= b)) continue;
-        a = a - cam->margin > cam->ox_lo ? a - cam->margin : cam->ox_lo;
-        b = b + cam->margin < cam->ox_hi ? b + cam->margin : cam->ox_hi;
-        pixel_range(a, b, g->cx, g->fx, g->cols, &j0, &j1);
-        if (j0 <= j1) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)j0, (uint32_t)(j1 - j0 + 1));
+        /* a NaN (which corners in the view should not give) keeps the box's columns */
+        if (!odd) {
+            if (!(a <= b)) continue;
+            a = a - cam->margin > cam->ox_lo ? a - cam->margin : cam->ox_lo;
+            b = b + cam->margin < cam->ox_hi ? b + cam->margin : cam->ox_hi;
+            pixel_range(a, b, g->cx, g->fx, g->cols, &r0, &r1);
+        }
+        if (r0 <= r1) test_run(tri, sc, (uint32_t)i * g->cols + (uint32_t)r0, (uint32_t)(r1 - r0 + 1));
     }
 }
 
