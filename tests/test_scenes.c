@@ -751,6 +751,76 @@ static void test_zero_area_updates(void **state)
     rc_context_destroy(ctx);
 }
 
+/* Ranges alone (the writer's loop without points and normals) against the
+ * same call with every attribute (its loop that tests each), bit for bit: a
+ * room with an opening, one pose 0.3 m from a wall (too near: -inf),
+ * range_max short of the far walls (+inf), through a spinning LiDAR and a
+ * camera (packets, or projected scans, in the built-in backend), three
+ * poses. */
+static void test_ranges_alone(void **state)
+{
+    uint32_t b = backend_of(state);
+    const float lo[3] = {-3.0f, -2.0f, -0.2f}, hi[3] = {6.0f, 3.0f, 2.5f};
+    const rc_pose poses[3] = {rct_pose_ypr(-2.7f, 0.5f, 1.0f, 2.8, 0.1, 0.0),
+                              rct_pose_ypr(1.0f, 1.0f, 1.2f, -2.0, 0.2, 0.4), rct_pose(0.5f, -1.7f, 0.8f)};
+    rc_context *ctx;
+    rc_scene *scene;
+    rcu_mesh m;
+    int k;
+    NEED_BACKEND(b);
+    ctx = rct_context(b, 2, 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &m), 0);
+    memmove(m.indices, m.indices + 6u, (m.triangle_count - 2u) * 3u * sizeof(uint32_t));
+    m.triangle_count -= 2u;
+    scene = rct_scene_mesh(ctx, &m, RC_MESH_REFERENCE);
+    for (k = 0; k < 2; ++k) {
+        rc_sensor *s = NULL;
+        rct_buffers all, alone;
+        uint64_t i, near = 0, none = 0, ok = 0;
+        const uint32_t rays = k == 0 ? 16u * 900u : 61u * 45u;
+        if (k == 0) {
+            rc_spherical_desc d = rc_spherical_desc_default();
+            d.common.range_min = 0.5f;
+            d.common.range_max = 5.0f;
+            d.theta.min = (float)(-180.0 * DEG);
+            d.theta.increment = (float)(0.4 * DEG);
+            d.theta.count = 900u;
+            d.phi.min = (float)(-15.0 * DEG);
+            d.phi.increment = (float)(2.0 * DEG);
+            d.phi.count = 16u;
+            RCT_OK(ctx, rc_sensor_create_spherical(ctx, &d, &s));
+        } else {
+            rc_pinhole_desc d = rc_pinhole_desc_default();
+            d.common.range_min = 0.5f;
+            d.common.range_max = 5.0f;
+            d.width = 61u; /* rows of 61 rays: runs that end mid-group */
+            d.height = 45u;
+            d.fx = d.fy = 40.0f;
+            d.cx = 30.0f;
+            d.cy = 22.0f;
+            RCT_OK(ctx, rc_sensor_create_pinhole(ctx, &d, &s));
+        }
+        rct_buffers_alloc(&all, 3u * rays, RC_ATTR_ALL);
+        rct_buffers_alloc(&alone, 3u * rays, RC_ATTR_RANGES);
+        RCT_OK(ctx, rc_simulate(ctx, scene, s, poses, 3u, &all.res));
+        RCT_OK(ctx, rc_simulate(ctx, scene, s, poses, 3u, &alone.res));
+        assert_memory_equal(all.res.ranges, alone.res.ranges, all.n * sizeof(float));
+        for (i = 0; i < all.n; ++i) {
+            const float r = alone.res.ranges[i];
+            near += isinf(r) && r < 0.0f;
+            none += isinf(r) && r > 0.0f;
+            ok += !isinf(r);
+        }
+        assert_true(near > 0 && none > 0 && ok > all.n / 4u);
+        rct_buffers_free(&all);
+        rct_buffers_free(&alone);
+        rc_sensor_destroy(s);
+    }
+    rc_scene_destroy(scene);
+    rcu_mesh_free(&m);
+    rc_context_destroy(ctx);
+}
+
 #define FOR_BACKENDS(f)                                            \
     cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),        \
         cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),    \
@@ -765,6 +835,7 @@ int main(void)
         FOR_BACKENDS(test_thread_independence), FOR_BACKENDS(test_only_requested_attributes),
         FOR_BACKENDS(test_coplanar_tie),      FOR_BACKENDS(test_pinhole_wall),
         FOR_BACKENDS(test_far_from_origin),   FOR_BACKENDS(test_zero_area_updates),
+        FOR_BACKENDS(test_ranges_alone),
     };
     return cmocka_run_group_tests_name("scenes (every backend)", tests, NULL, NULL);
 }
