@@ -6,8 +6,8 @@
  * found on its image: the triangle, clipped to the view's frustum, projects
  * to a polygon whose corners bound the pixels it can cover. Only those rays
  * run the watertight test against the triangle. The mesh's tree is walked
- * once a scan, only to pass over boxes no row meets (or outside the
- * camera's view), so on a mesh with fewer triangles than the scan has rays
+ * once a scan (or a band of its rows), only to pass over boxes no row meets
+ * (or outside the camera's view), so on a mesh with fewer triangles than the scan has rays
  * this costs a few tests a ray where the packets pay their node visits
  * (docs/architecture.md, "Projected scans"). Cones, clip planes and pixel
  * bounds are widened beyond every rounding of the test, and each test is
