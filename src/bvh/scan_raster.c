@@ -695,19 +695,13 @@ static RC__FORCE_INLINE void raster_pinhole(const raster_tri *tri, const raster_
     }
 }
 
-/* 1 when some point of the box (child c of n, the map frame) may lie in the
- * camera's widened view and within tmax of the origin. */
-static RC__FORCE_INLINE int pinhole_box_visible(const raster_scan *sc, const rc__wnode *n, int c)
+/* 1 when some point of a box (centre m relative to the origin, half
+ * extents h) may lie in the camera's widened view and within tmax of the
+ * origin. */
+static RC__FORCE_INLINE int pinhole_box_visible(const raster_scan *sc, const double m[3], const double h[3])
 {
-    double m[3], h[3], h2 = 0.0, m2 = 0.0;
-    int k, p;
-    for (k = 0; k < 3; ++k) {
-        const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
-        m[k] = 0.5 * (lo + hi) - sc->org[k];
-        h[k] = 0.5 * (hi - lo);
-        h2 += h[k] * h[k];
-        m2 += m[k] * m[k];
-    }
+    const double h2 = h[0] * h[0] + h[1] * h[1] + h[2] * h[2], m2 = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+    int p;
     /* the box's nearest point is no nearer than its bounding sphere's */
     if (sqrt(m2) - sqrt(h2) > sc->tmax * (1.0 + 1e-6)) return 0;
     for (p = 0; p < 4; ++p) {
@@ -770,19 +764,19 @@ static RC__FORCE_INLINE void raster_tree(const raster_scan *sc)
         const rc__wnode *n = &nodes[node];
         int c;
         for (c = 0; c < 4; ++c) {
-            double m[3], h2 = 0.0, rad;
-            rc__cone cone;
+            double m[3], h[3];
             int k;
             if (n->child[c] == RC__WIDE_EMPTY) continue;
+            for (k = 0; k < 3; ++k) {
+                const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
+                m[k] = 0.5 * (lo + hi) - sc->org[k];
+                h[k] = 0.5 * (hi - lo);
+            }
             if (sc->g->pinhole) {
-                if (!pinhole_box_visible(sc, n, c)) continue;
+                if (!pinhole_box_visible(sc, m, h)) continue;
             } else {
-                for (k = 0; k < 3; ++k) {
-                    const double lo = n->box[2 * k][c], hi = n->box[2 * k + 1][c];
-                    m[k] = 0.5 * (lo + hi) - sc->org[k];
-                    h2 += 0.25 * (hi - lo) * (hi - lo);
-                }
-                rad = sqrt(h2) * (1.0 + 1e-9);
+                const double rad = sqrt(h[0] * h[0] + h[1] * h[1] + h[2] * h[2]) * (1.0 + 1e-9);
+                rc__cone cone;
                 if (rc__cone_place(sc->g, sc->r, sc->tmax, m, rad,
                                    sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) + rad, &cone) == RC__CONE_NONE)
                     continue;
