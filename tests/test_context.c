@@ -56,7 +56,7 @@ static void test_caller_block_and_stats(void **state)
     rc_context_desc d = rc_context_desc_default();
     rc_context *ctx = NULL;
     rc_memory_stats ms = rc_memory_stats_default();
-    size_t need = 0;
+    size_t need = 0, backend_need = 0;
     void *mem;
     uint32_t backend = 0, threads = 0;
     (void)state;
@@ -83,6 +83,15 @@ static void test_caller_block_and_stats(void **state)
     /* an error names its argument */
     assert_int_equal(rc_context_get_memory_stats(ctx, NULL), RC_ERR_INVALID_ARGUMENT);
     assert_non_null(strstr(rc_context_last_error(ctx), "stats"));
+    rc_context_destroy(ctx);
+    /* AUTO is the built-in backend in every build, Embree's included, and
+     * sizes its context as that backend does */
+    d.backend = RC_BACKEND_AUTO;
+    assert_int_equal(rc_context_memory_requirements(&d, &backend_need), RC_OK);
+    assert_int_equal(backend_need, need);
+    assert_int_equal(rc_context_create(&d, &ctx), RC_OK);
+    assert_int_equal(rc_context_get_backend(ctx, &backend), RC_OK);
+    assert_int_equal(backend, RC_BACKEND_BVH);
     rc_context_destroy(ctx);
     free(mem);
 }

@@ -165,7 +165,7 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
     if (!out) return create_fail(desc, RC_ERR_INVALID_ARGUMENT, "rc_context_create: out is NULL");
     st = resolve_desc(desc, &backend, &threads, why);
     if (st != RC_OK) return create_fail(desc, st, "rc_context_create: %s", why);
-    if (desc->backend != RC_BACKEND_AUTO && !backend->available())
+    if (!backend->available())
         return create_fail(desc, RC_ERR_UNSUPPORTED, "rc_context_create: backend %s is built in but not usable here",
                            backend->name);
 
@@ -215,19 +215,6 @@ rc_status rc_context_create(const rc_context_desc *desc, rc_context **out)
 
     st = rc__pool_create(&ctx->arena, threads, &ctx->pool);
     if (st == RC_OK) st = backend->init(ctx, desc);
-    if (st != RC_OK && ctx->pool && desc->backend == RC_BACKEND_AUTO && backend != &rc__backend_bvh) {
-        /* AUTO: a backend that is built in but cannot start here (no device)
-         * falls back to the built-in one. Its failed init released what it took. */
-        if (desc->log) {
-            char warn[RC__ERROR_TEXT + 64];
-            snprintf(warn, sizeof warn, "AUTO: %s failed to start (%s); using bvh", backend->name, ctx->last_error);
-            desc->log(desc->log_user, RC_LOG_WARN, warn);
-        }
-        backend = &rc__backend_bvh;
-        ctx->backend = backend;
-        ctx->backend_id = backend->id;
-        st = backend->init(ctx, desc);
-    }
     if (st != RC_OK) {
         /* the reason is in the dying context's last error: copy it out first */
         memcpy(why, ctx->last_error, sizeof why);

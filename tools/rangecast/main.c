@@ -28,7 +28,7 @@ static void usage(FILE *f)
         "  gen        write the benchmark workload (UV sphere, random poses) or the demo map to files\n"
         "  help       this text ('rangecast COMMAND --help' for a command's options)\n"
         "\n"
-        "Backends in this library: %s (auto picks embree when present, else bvh).\n"
+        "Backends in this library: %s (auto is bvh).\n"
         "Sensors: vlp16, vlp16-360, os1-64, d435, livox-mid40; ouster:FILE.json (an Ouster unit's metadata).\n"
         "Maps: %s.\n"
         "Images: %s.\n"

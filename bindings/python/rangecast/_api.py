@@ -112,7 +112,7 @@ def _ptr(array, ctype):
 class Context(object):
     """A rangecast context: its arena, threads and backend.
 
-    backend: "auto" (Embree where built in, else the built-in BVH), "bvh",
+    backend: "auto" (the built-in BVH), "bvh",
     "embree" or "vulkan". threads: 0 = every CPU, 1 = the caller's thread.
     arena_bytes: the one block the library allocates at creation (0 = its
     default, 256 MiB); size it with memory_requirements-style sums in C, or
