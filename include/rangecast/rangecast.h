@@ -158,7 +158,7 @@ typedef int (*rc_progress_fn)(void *user, const char *stage, double fraction);
 typedef struct rc_context rc_context;
 
 #define RC_BACKEND_DEFAULT 0u /* = AUTO */
-#define RC_BACKEND_AUTO    0u /* the built-in BVH (README, "Backends") */
+#define RC_BACKEND_AUTO    0u /* the built-in BVH (README, "Backends and build options") */
 #define RC_BACKEND_BVH     1u /* built-in SAH BVH, always present */
 #define RC_BACKEND_EMBREE  2u
 #define RC_BACKEND_VULKAN  3u

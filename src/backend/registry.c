@@ -12,9 +12,9 @@ const rc__backend *rc__backend_find(uint32_t id)
 {
     switch (id) {
     /* AUTO is the built-in backend on every platform: it outran the Embree
-     * backend on every grid sensor and O1Dn pattern measured (1.4-4x), keeps
-     * to the caller's arena, and gives the same bits on x86 and ARM boards
-     * (which have no Embree). Embree wins incoherent OnDn rays from scattered
+     * backend on every grid sensor and O1Dn pattern measured (1.1-4x), keeps
+     * to the caller's arena, and is what ARM boards (no Embree) run, so a
+     * desktop and the robot trace with the same code. Embree wins incoherent OnDn rays from scattered
      * origins; callers ask for it by name (docs/benchmarks.md, session 34). */
     case RC_BACKEND_AUTO:
     case RC_BACKEND_BVH: return &rc__backend_bvh;
