@@ -685,6 +685,11 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
  * 0.77 of the 1.13 leaf visits). The tests, offers and tie rule are the
  * packet's, so the lane gets the same hit. Sets *shrunk when its tmax
  * shrank. */
+#if !defined(__OPTIMIZE_SIZE__)
+/* Left out of -Os builds (the static core for small boards: its 1.4 KB on
+ * aarch64 would take that core past its 200 KB budget, docs/benchmarks.md);
+ * there a lone lane stays in the packet, with the same results. */
+#define RC__PACKET_LONE_LANE 1
 typedef struct lone_entry {
     uint32_t child, count;
     float tnear;
@@ -753,6 +758,7 @@ static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uin
         count = stack[sp].count;
     }
 }
+#endif
 
 /* Handles T's current node or leaf and moves to the next entry. With
  * interleaved set (a constant at every call) it works in turns as described
@@ -769,12 +775,15 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         for (i = 0; i < T->n; ++i) rc__hit_settle(&T->hits[i], mesh->bvh.refs);
         return 0;
     }
+#if defined(RC__PACKET_LONE_LANE)
     if (!interleaved && !(mask & (mask - 1u))) {
         /* one live lane: the rest of this subtree is that lane's alone */
         int shrunk = 0;
         lone_lane(T, mesh, lowest_lane(mask), child, T->count, geom, inst, &shrunk);
         if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L);
-    } else if (T->count == 0) {
+    } else
+#endif
+    if (T->count == 0) {
         const rc__wnode *nd = &nodes[child];
         /* the met children go straight onto the stack, farthest first: the
          * last is visited next, the others stay pushed */
