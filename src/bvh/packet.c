@@ -690,17 +690,12 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
  * aarch64 would take that core past its 200 KB budget, docs/benchmarks.md);
  * there a lone lane stays in the packet, with the same results. */
 #define RC__PACKET_LONE_LANE 1
-typedef struct lone_entry {
-    uint32_t child, count;
-    float tnear;
-} lone_entry;
-
 static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uint32_t lane, uint32_t child,
                                        uint32_t count, uint32_t geom, uint32_t inst, int *shrunk)
 {
     const rc__wnode *nodes = mesh->wide;
     const rc__ray *ray = &T->rays[lane];
-    lone_entry stack[PACKET_STACK + 4u]; /* room for one node's children past the end */
+    rc__wide_entry stack[PACKET_STACK + 4u]; /* room for one node's children past the end */
     uint32_t sp = 0;
     for (;;) {
         if (count == 0) {
@@ -710,21 +705,14 @@ static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uin
             if (met) {
                 /* sorted onto the stack, farthest first; the nearest, on
                  * top, is visited next (of equal ones the earlier) */
-                lone_entry *const e = stack + sp;
+                rc__wide_entry *const e = stack + sp;
                 uint32_t m = 0;
                 while (met) {
                     const uint32_t c = lowest_lane(met);
-                    lone_entry x;
-                    uint32_t j;
                     met &= met - 1u;
                     if (n->child[c] == RC__WIDE_EMPTY) continue;
                     rc__prefetch_next(nodes, mesh->leaf_tris, n->child[c], n->count[c]);
-                    x.child = n->child[c];
-                    x.count = n->count[c];
-                    x.tnear = tn[c];
-                    for (j = m; j > 0 && e[j - 1].tnear <= x.tnear; --j) e[j] = e[j - 1];
-                    e[j] = x;
-                    ++m;
+                    m = rc__wide_add_sorted(e, m, n, c, tn);
                 }
                 if (m > 0) {
                     child = e[m - 1].child;

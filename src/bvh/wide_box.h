@@ -91,4 +91,28 @@ static RC__FORCE_INLINE uint32_t rc__wide_box_test(const rc__wnode *n, const uin
 #endif
 }
 
+/* A child waiting on a single ray's traversal stack (wide_trace.c, and a
+ * packet's lone lane in packet.c), with its entry distance. */
+typedef struct rc__wide_entry {
+    uint32_t child;
+    uint32_t count;
+    float tnear;
+} rc__wide_entry;
+
+/* Adds child c of n (entry distance tn[c]) to e[0..m), kept in stack order:
+ * farthest first, so the nearest is on top and visited next (of equal ones
+ * the earlier); returns m + 1. */
+static RC__FORCE_INLINE uint32_t rc__wide_add_sorted(rc__wide_entry *e, uint32_t m, const rc__wnode *n, uint32_t c,
+                                                     const float tn[4])
+{
+    rc__wide_entry x;
+    uint32_t i;
+    x.child = n->child[c];
+    x.count = n->count[c];
+    x.tnear = tn[c];
+    for (i = m; i > 0 && e[i - 1].tnear <= x.tnear; --i) e[i] = e[i - 1];
+    e[i] = x;
+    return m + 1;
+}
+
 #endif

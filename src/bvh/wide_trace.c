@@ -18,12 +18,6 @@
 /* Three pushes per level at most, over at most RC__BVH_MAX_DEPTH levels. */
 #define STACK_SIZE (3u * RC__BVH_MAX_DEPTH + 4u)
 
-typedef struct wide_entry {
-    uint32_t child;
-    uint32_t count;
-    float tnear;
-} wide_entry;
-
 /* Per-ray constants: origin, reciprocal direction, and which plane row
  * (0..5) of a node each axis enters by. (Keeping them splatted in memory
  * measured 15% slower than splatting per node: the compiler keeps these in
@@ -62,22 +56,6 @@ static RC__FORCE_INLINE uint32_t wide_box_test(const rc__wnode *n, const wide_ra
     return rc__wide_box_test(n, w->near_row, w->org, w->inv, tmax, tn);
 }
 
-/* Adds child c of n to e[0..m), kept in stack order: farthest first, so
- * the nearest is on top and visited next (of equal ones the earlier);
- * returns m + 1. */
-static RC__FORCE_INLINE uint32_t add_sorted(wide_entry *e, uint32_t m, const rc__wnode *n, uint32_t c,
-                                            const float tn[4])
-{
-    wide_entry x;
-    uint32_t i;
-    x.child = n->child[c];
-    x.count = n->count[c];
-    x.tnear = tn[c];
-    for (i = m; i > 0 && e[i - 1].tnear <= x.tnear; --i) e[i] = e[i - 1];
-    e[i] = x;
-    return m + 1;
-}
-
 static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst,
                                      rc__hit *hit, float tmax, int any_hit)
 {
@@ -89,7 +67,7 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
     const size_t stride = mesh->stride;
     const rc__ray r = *ray;
     wide_ray w;
-    wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
+    rc__wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
     uint32_t sp = 0, child = 0, count = 0;
     float tcur = tmax;
     int found = 0;
@@ -114,12 +92,12 @@ static RC__FORCE_INLINE int wide_traverse(const rc__mesh *mesh, const rc__ray *r
                     /* two to four met: sorted by entry distance straight
                      * onto the stack, farthest first; the nearest, on top,
                      * is visited next */
-                    wide_entry *const e = stack + sp;
-                    uint32_t m = add_sorted(e, 0, n, c, tn);
+                    rc__wide_entry *const e = stack + sp;
+                    uint32_t m = rc__wide_add_sorted(e, 0, n, c, tn);
                     while (mask) {
                         c = lowest_bit(mask);
                         mask &= mask - 1u;
-                        m = add_sorted(e, m, n, c, tn);
+                        m = rc__wide_add_sorted(e, m, n, c, tn);
                     }
                     child = e[m - 1].child;
                     count = e[m - 1].count;
@@ -208,7 +186,7 @@ typedef struct ray_turns {
     float tcur;
     uint32_t sp, child, count, staged;
     int found, settling;
-    wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
+    rc__wide_entry stack[STACK_SIZE + 4u]; /* room for one node's children past the end */
 } ray_turns;
 
 static void turns_start(ray_turns *T, const rc__ray *ray, rc__hit *hit)
@@ -233,12 +211,12 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
         float tn[4] RC__ALIGN16;
         uint32_t mask = wide_box_test(n, &T->w, T->tcur, tn);
         if (mask) {
-            wide_entry *const e = T->stack + T->sp; /* as wide_traverse: sorted onto the stack */
+            rc__wide_entry *const e = T->stack + T->sp; /* as wide_traverse: sorted onto the stack */
             uint32_t m = 0;
             while (mask) {
                 const uint32_t c = lowest_bit(mask);
                 mask &= mask - 1u;
-                m = add_sorted(e, m, n, c, tn);
+                m = rc__wide_add_sorted(e, m, n, c, tn);
             }
             T->child = e[m - 1].child;
             T->count = e[m - 1].count;
