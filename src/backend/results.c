@@ -54,6 +54,36 @@ static RC__FORCE_INLINE float refined_range(const rc_sensor *sensor, int found, 
     return found && t < sensor->range_min ? -INFINITY : INFINITY;
 }
 
+#if defined(RC__HIT_DISTANCES_SSE2)
+/* refined_range for four rays at once in SSE2 lanes: the same compares, the
+ * same conversion and the same choices, so the same bits. range[j] gets ray
+ * j's range; bit j of the result is its valid. */
+static RC__FORCE_INLINE uint32_t refined_ranges4(const rc_sensor *sensor, const int *found, const rc__hit *hits,
+                                                 const double *td, float range[4])
+{
+    const __m128d d01 = _mm_loadu_pd(td), d23 = _mm_loadu_pd(td + 2), zero_d = _mm_setzero_pd();
+    const __m128d big = _mm_set1_pd(3.0e38);
+    /* td > 0 && td < 3e38 as 64-bit masks, then narrowed to four 32-bit lanes */
+    const __m128d ok01 = _mm_and_pd(_mm_cmpgt_pd(d01, zero_d), _mm_cmplt_pd(d01, big));
+    const __m128d ok23 = _mm_and_pd(_mm_cmpgt_pd(d23, zero_d), _mm_cmplt_pd(d23, big));
+    const __m128 ok = _mm_shuffle_ps(_mm_castpd_ps(ok01), _mm_castpd_ps(ok23), _MM_SHUFFLE(2, 0, 2, 0));
+    const __m128 tf = _mm_movelh_ps(_mm_cvtpd_ps(d01), _mm_cvtpd_ps(d23));
+    const __m128 missed = _mm_castsi128_ps(
+        _mm_cmpeq_epi32(_mm_loadu_si128((const __m128i *)(const void *)found), _mm_setzero_si128()));
+    /* found ? hit->t : 0, then the refined distance where it is usable */
+    const __m128 t_hit = _mm_andnot_ps(missed, _mm_setr_ps(hits[0].t, hits[1].t, hits[2].t, hits[3].t));
+    const __m128 use = _mm_andnot_ps(missed, _mm_and_ps(ok, _mm_cmpgt_ps(tf, _mm_setzero_ps())));
+    const __m128 t = _mm_or_ps(_mm_and_ps(use, tf), _mm_andnot_ps(use, t_hit));
+    const __m128 rmin = _mm_set1_ps(sensor->range_min);
+    const __m128 valid =
+        _mm_andnot_ps(missed, _mm_and_ps(_mm_cmpge_ps(t, rmin), _mm_cmple_ps(t, _mm_set1_ps(sensor->range_max))));
+    const __m128 near = _mm_andnot_ps(missed, _mm_cmplt_ps(t, rmin));
+    const __m128 none = _mm_or_ps(_mm_and_ps(near, _mm_set1_ps(-INFINITY)), _mm_andnot_ps(near, _mm_set1_ps(INFINITY)));
+    _mm_storeu_ps(range, _mm_or_ps(_mm_and_ps(valid, t), _mm_andnot_ps(valid, none)));
+    return (uint32_t)_mm_movemask_ps(valid);
+}
+#endif
+
 /* rc__write_result given the hit's refined distance td */
 static RC__FORCE_INLINE void write_refined(const rc__sim_job *job, uint64_t k, const float dir_s[3],
                                            const float *org_s, int found, const rc__hit *hit, double td,
@@ -134,7 +164,29 @@ static RC__FORCE_INLINE void write_rays(const rc__sim_job *job, uint64_t base, c
         uint32_t *const prim_out = attr & RC_ATTR_PRIM_IDS ? out->prim_ids : NULL;
         uint32_t *const geom_out = attr & RC_ATTR_GEOM_IDS ? out->geom_ids : NULL;
         uint32_t *const inst_out = attr & RC_ATTR_INST_IDS ? out->inst_ids : NULL;
-        for (i = 0; i < n; ++i) {
+        i = 0;
+#if defined(RC__HIT_DISTANCES_SSE2)
+        /* four rays' ranges at once (refined_ranges4), stored ray by ray */
+        for (; i + 4u <= n; i += 4u) {
+            float range[4];
+            const uint32_t valid = refined_ranges4(job->sensor, found + i, hits + i, td + i, range);
+            uint64_t k[4];
+            uint32_t j;
+            /* an attribute's test once for the four */
+            for (j = 0; j < 4u; ++j) k[j] = base + (idx ? idx[i + j] : first + i + j);
+            if (range_out)
+                for (j = 0; j < 4u; ++j) range_out[k[j]] = range[j];
+            if (hit_out)
+                for (j = 0; j < 4u; ++j) hit_out[k[j]] = (uint8_t)((valid >> j) & 1u);
+            if (prim_out)
+                for (j = 0; j < 4u; ++j) prim_out[k[j]] = (valid >> j) & 1u ? hits[i + j].prim : RC_INVALID_ID;
+            if (geom_out)
+                for (j = 0; j < 4u; ++j) geom_out[k[j]] = (valid >> j) & 1u ? hits[i + j].geom : RC_INVALID_ID;
+            if (inst_out)
+                for (j = 0; j < 4u; ++j) inst_out[k[j]] = (valid >> j) & 1u ? hits[i + j].inst : RC_INVALID_ID;
+        }
+#endif
+        for (; i < n; ++i) {
             const uint64_t k = base + (idx ? idx[i] : first + i);
             int valid;
             const float range = refined_range(job->sensor, found[i], &hits[i], td[i], &valid);
