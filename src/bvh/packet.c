@@ -151,19 +151,32 @@ static inline uint32_t box_mask(const node_planes *pl, uint32_t c, const packet_
     const BOX_V vnx = BOX_SET1(nx), vny = BOX_SET1(ny), vnz = BOX_SET1(nz);
     const BOX_V vfx = BOX_SET1(fx), vfy = BOX_SET1(fy), vfz = BOX_SET1(fz);
     const BOX_V scale = BOX_SET1(RC__SLAB_FAR_SCALE);
-    for (g = 0; g < LANES / BOX_W; ++g) {
-        const BOX_V ix = BOX_LOAD(L->ix + BOX_W * g), iy = BOX_LOAD(L->iy + BOX_W * g);
-        const BOX_V iz = BOX_LOAD(L->iz + BOX_W * g);
-        /* max/min return their second operand when the first is NaN: a NaN
-         * (0 * inf, origin on a plane of a parallel ray) imposes nothing */
-        BOX_V t0 = BOX_MAX(BOX_MUL(vnx, ix), BOX_SET1(0.0f));
-        BOX_V t1 = BOX_MIN(BOX_MUL(vfx, ix), BOX_LOAD(L->tmax + BOX_W * g));
-        t0 = BOX_MAX(BOX_MUL(vny, iy), t0);
-        t0 = BOX_MAX(BOX_MUL(vnz, iz), t0);
-        t1 = BOX_MIN(BOX_MUL(vfy, iy), t1);
-        t1 = BOX_MIN(BOX_MUL(vfz, iz), t1);
-        out |= BOX_LE_BITS(t0, BOX_MUL(t1, scale)) << (BOX_W * g);
+    /* rows g of lanes from a to b (constants in each loop below, so each
+     * unrolls) */
+#define BOX_ROWS(a, b)                                                                                             \
+    for (g = (a); g < (b); ++g) {                                                                                  \
+        const BOX_V ix = BOX_LOAD(L->ix + BOX_W * g), iy = BOX_LOAD(L->iy + BOX_W * g);                            \
+        const BOX_V iz = BOX_LOAD(L->iz + BOX_W * g);                                                              \
+        /* max/min return their second operand when the first is NaN: a NaN                                       \
+         * (0 * inf, origin on a plane of a parallel ray) imposes nothing */                                       \
+        BOX_V t0 = BOX_MAX(BOX_MUL(vnx, ix), BOX_SET1(0.0f));                                                      \
+        BOX_V t1 = BOX_MIN(BOX_MUL(vfx, ix), BOX_LOAD(L->tmax + BOX_W * g));                                       \
+        t0 = BOX_MAX(BOX_MUL(vny, iy), t0);                                                                        \
+        t0 = BOX_MAX(BOX_MUL(vnz, iz), t0);                                                                        \
+        t1 = BOX_MIN(BOX_MUL(vfy, iy), t1);                                                                        \
+        t1 = BOX_MIN(BOX_MUL(vfz, iz), t1);                                                                        \
+        out |= BOX_LE_BITS(t0, BOX_MUL(t1, scale)) << (BOX_W * g);                                                 \
     }
+    /* a tile's two rows part deep in the tree: lanes of one half only (one
+     * row of a 2 x 16 tile) test that half's rows */
+    if (!(mask >> (LANES / 2u))) {
+        BOX_ROWS(0u, LANES / BOX_W / 2u)
+    } else if (!(mask & ((1u << (LANES / 2u)) - 1u))) {
+        BOX_ROWS(LANES / BOX_W / 2u, LANES / BOX_W)
+    } else {
+        BOX_ROWS(0u, LANES / BOX_W)
+    }
+#undef BOX_ROWS
 #undef BOX_W
 #undef BOX_V
 #undef BOX_SET1
