@@ -166,13 +166,13 @@ static RC__FORCE_INLINE void write_rays(const rc__sim_job *job, uint64_t base, c
         uint32_t *const inst_out = attr & RC_ATTR_INST_IDS ? out->inst_ids : NULL;
         i = 0;
 #if defined(RC__HIT_DISTANCES_SSE2)
-        /* four rays' ranges at once (refined_ranges4), stored ray by ray */
+        /* four rays' ranges at once (refined_ranges4), then each requested
+         * attribute stored for the four */
         for (; i + 4u <= n; i += 4u) {
             float range[4];
             const uint32_t valid = refined_ranges4(job->sensor, found + i, hits + i, td + i, range);
             uint64_t k[4];
             uint32_t j;
-            /* an attribute's test once for the four */
             for (j = 0; j < 4u; ++j) k[j] = base + (idx ? idx[i + j] : first + i + j);
             if (range_out)
                 for (j = 0; j < 4u; ++j) range_out[k[j]] = range[j];
