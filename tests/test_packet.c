@@ -30,19 +30,30 @@ static void hit_init(rc__hit *h)
     h->prim = h->geom = h->inst = h->slot = RC_INVALID_ID;
 }
 
-/* Each ray's packet hit against the single-ray traversal's. */
-static void expect_single(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, const rc__hit *hp, const int *fp)
+/* Hits left with a pending prim id (RC__PACKET_PRIMS_PENDING) */
+static uint64_t pending_seen;
+
+/* Each ray's packet hit against the single-ray traversal's. A prim id may be
+ * pending only with RC__PACKET_PRIMS_PENDING; its slot then gives the same
+ * triangle. */
+static void expect_single(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, const rc__hit *hp, const int *fp,
+                          uint32_t flags)
 {
     uint32_t i;
     for (i = 0; i < n; ++i) {
-        rc__hit hs;
+        rc__hit hs, h = hp[i];
         int fs;
         hit_init(&hs);
         fs = rc__mesh_intersect(mesh, &rays[i], 0, RC_INVALID_ID, &hs);
         assert_int_equal(fp[i], fs);
         if (!fs) continue;
-        assert_int_equal(hp[i].prim, hs.prim);
-        assert_memory_equal(&hp[i].t, &hs.t, sizeof(float));
+        if (h.prim == RC__PRIM_PENDING) {
+            assert_true(flags & RC__PACKET_PRIMS_PENDING);
+            ++pending_seen;
+            rc__hit_settle(&h, mesh->bvh.refs);
+        }
+        assert_int_equal(h.prim, hs.prim);
+        assert_memory_equal(&h.t, &hs.t, sizeof(float));
     }
 }
 
@@ -123,9 +134,9 @@ static uint32_t make_tile(uint32_t tile, rc__ray rays[RC__PACKET_SIZE], rc__hit 
 }
 
 typedef void (*packet_fn)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                          rc__hit *hits, int *found, int own_origins);
+                          rc__hit *hits, int *found, uint32_t flags);
 typedef void (*packets_fn)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays, const uint32_t *n,
-                           uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found, int own_origins);
+                           uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found, uint32_t flags);
 
 /* A build of the traversal: the entry points, or one of the two x86-64
  * builds behind them. */
@@ -142,33 +153,37 @@ static const packet_build baseline = {"baseline SSE2", rc__mesh_intersect_packet
 static const packet_build avx2 = {"AVX2", rc__mesh_intersect_packet_avx2, rc__mesh_intersect_packets_avx2};
 #endif
 
-static void packet_equals_single(const packet_build *b, int own_origins)
+static void packet_equals_single(const packet_build *b, uint32_t flags)
 {
     test_map t;
     uint32_t tile, tiles = rct_quick() ? 300u : 3000u;
-    print_message("packets: %s build%s\n", b->name, own_origins ? ", own origins" : "");
+    const int own_origins = (flags & RC__PACKET_OWN_ORIGINS) != 0u;
+    print_message("packets: %s build%s%s\n", b->name, own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
     map_open(&t);
     for (tile = 0; tile < tiles; ++tile) {
         rc__ray rays[RC__PACKET_SIZE];
         rc__hit hits[RC__PACKET_SIZE];
         int found[RC__PACKET_SIZE];
         const uint32_t n = make_tile(tile, rays, hits, found, own_origins);
-        b->one(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found, own_origins);
-        expect_single(t.mesh, rays, n, hits, found);
+        b->one(t.mesh, rays, n, 0, RC_INVALID_ID, hits, found, flags);
+        expect_single(t.mesh, rays, n, hits, found, flags);
     }
     map_close(&t);
 }
 
 /* Groups of 1..RC__PACKETS_IN_FLIGHT packets taking turns (each group mixes
  * the tile kinds above, so some members fall back to the plain path). */
-static void packets_in_turns_equal_single(const packet_build *b, int own_origins)
+static void packets_in_turns_equal_single(const packet_build *b, uint32_t flags)
 {
+    const int own_origins = (flags & RC__PACKET_OWN_ORIGINS) != 0u;
     test_map t;
     static rc__ray rays[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     uint32_t group, tile = 0, groups = rct_quick() ? 60u : 600u;
-    print_message("packets in turns: %s build%s\n", b->name, own_origins ? ", own origins" : "");
+    print_message("packets in turns: %s build%s%s\n", b->name, own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
     map_open(&t);
     for (group = 0; group < groups; ++group) {
         const uint32_t k = 1u + group % RC__PACKETS_IN_FLIGHT;
@@ -182,8 +197,8 @@ static void packets_in_turns_equal_single(const packet_build *b, int own_origins
             ph[j] = hits[j];
             pf[j] = found[j];
         }
-        b->many(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf, own_origins);
-        for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j]);
+        b->many(t.mesh, k, pr, n, 0, RC_INVALID_ID, ph, pf, flags);
+        for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j], flags);
     }
     map_close(&t);
 }
@@ -204,8 +219,20 @@ static void test_packets_in_turns_equal_single(void **state)
 static void test_own_origins_equal_single(void **state)
 {
     (void)state;
-    packet_equals_single(&selected, 1);
-    packets_in_turns_equal_single(&selected, 1);
+    packet_equals_single(&selected, RC__PACKET_OWN_ORIGINS);
+    packets_in_turns_equal_single(&selected, RC__PACKET_OWN_ORIGINS);
+}
+
+/* Prim ids left pending (a call that writes none): the same hits, and the
+ * slot names the single-ray traversal's triangle; without the flag none is
+ * left pending (expect_single) */
+static void test_pending_prims_equal_single(void **state)
+{
+    (void)state;
+    pending_seen = 0;
+    packet_equals_single(&selected, RC__PACKET_PRIMS_PENDING);
+    packets_in_turns_equal_single(&selected, RC__PACKET_PRIMS_PENDING | RC__PACKET_OWN_ORIGINS);
+    assert_true(pending_seen > 0);
 }
 
 /* Both x86-64 builds, whichever the CPU selects (the AVX2 one where it has
@@ -214,18 +241,19 @@ static void test_both_builds_equal_single(void **state)
 {
     (void)state;
 #if defined(RC__PACKET_TWO_BUILDS)
-    int own;
-    for (own = 0; own < 2; ++own) {
-        packet_equals_single(&baseline, own);
-        packets_in_turns_equal_single(&baseline, own);
+    uint32_t flags;
+    /* 0, own origins, prim ids pending, both */
+    for (flags = 0; flags < 4u; ++flags) {
+        packet_equals_single(&baseline, flags);
+        packets_in_turns_equal_single(&baseline, flags);
     }
     if (!rc__leaf4_have_avx2()) {
         print_message("no AVX2 on this CPU: its build is not run\n");
         return;
     }
-    for (own = 0; own < 2; ++own) {
-        packet_equals_single(&avx2, own);
-        packets_in_turns_equal_single(&avx2, own);
+    for (flags = 0; flags < 4u; ++flags) {
+        packet_equals_single(&avx2, flags);
+        packets_in_turns_equal_single(&avx2, flags);
     }
 #else
     print_message("one build of the traversal on this target\n");
@@ -260,6 +288,7 @@ int main(void)
     const struct CMUnitTest tests[] = {cmocka_unit_test(test_packet_equals_single),
                                        cmocka_unit_test(test_packets_in_turns_equal_single),
                                        cmocka_unit_test(test_own_origins_equal_single),
+                                       cmocka_unit_test(test_pending_prims_equal_single),
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);

@@ -28,7 +28,7 @@
 int rc__mesh_intersect_wide(const rc__mesh *mesh, const rc__ray *ray, uint32_t geom, uint32_t inst, rc__hit *hit);
 int rc__mesh_occluded_wide(const rc__mesh *mesh, const rc__ray *ray, float tmax);
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                               rc__hit *hits, int *found, int own_origins);
+                               rc__hit *hits, int *found, uint32_t flags);
 
 /* the tools' generator, seeded in main */
 static rcu_rng rng;
@@ -112,8 +112,8 @@ static void test_scalar_equals_simd(void **state)
             hit_init(&hv[i]);
             fs[i] = fv[i] = 0;
         }
-        scalar_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hs, fs, own);
-        rc__mesh_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hv, fv, own);
+        scalar_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hs, fs, own ? RC__PACKET_OWN_ORIGINS : 0u);
+        rc__mesh_intersect_packet(mesh, r, RC__PACKET_SIZE, 0, RC_INVALID_ID, hv, fv, own ? RC__PACKET_OWN_ORIGINS : 0u);
         for (i = 0; i < RC__PACKET_SIZE; ++i) {
             same_hit(fs[i], &hs[i], fv[i], &hv[i]);
             same_hit(f1[i], &h1[i], fv[i], &hv[i]); /* and the single ray's */

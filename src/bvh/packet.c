@@ -446,7 +446,7 @@ static int octant_of(const rc__ray *r)
 /* A tile that straddles an axis plane: one packet per octant present (a ray
  * alone goes through the single-ray traversal). */
 static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                            rc__hit *hits, int *found, int own_origins)
+                            rc__hit *hits, int *found, uint32_t flags)
 {
     uint32_t done = 0, i;
     while (done != (n >= 32u ? 0xFFFFFFFFu : (1u << n) - 1u)) {
@@ -469,7 +469,7 @@ static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t 
         if (m == 1) {
             sub_found[0] = rc__mesh_intersect(mesh, &sub[0], geom, inst, &sub_hits[0]);
         } else {
-            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found, own_origins);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found, flags);
         }
         for (i = 0; i < m; ++i) {
             hits[idx[i]] = sub_hits[i];
@@ -491,6 +491,7 @@ typedef struct packet_trav {
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
+    uint32_t settle;   /* 0: hits may keep their prim pending (RC__PACKET_PRIMS_PENDING) */
     /* up to three pushes per level, and room for one node's children past the end */
     packet_entry stack[PACKET_STACK + 4u];
 } packet_trav;
@@ -632,11 +633,12 @@ static void lanes_origins(packet_lanes *L, const rc__ray *rays, uint32_t n, int 
 /* Starts T on the root. 0 when the packet cannot run as one (empty, too
  * large, mixed octants, no tree): the caller takes the rays another way. */
 static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
-                     int *found, int own_origins)
+                     int *found, uint32_t flags)
 {
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
     if (!lanes_fill(&T->L, &T->P, rays, n, hits)) return 0;
-    lanes_origins(&T->L, rays, n, own_origins);
+    lanes_origins(&T->L, rays, n, (flags & RC__PACKET_OWN_ORIGINS) != 0u);
+    T->settle = !(flags & RC__PACKET_PRIMS_PENDING);
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     T->rays = rays;
     T->hits = hits;
@@ -900,6 +902,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     do {
         if (T->sp == 0) {
             uint32_t i;
+            if (!T->settle) return 0;
             if (interleaved) {
                 /* a prim id is a read from refs, a miss on a large map:
                  * prefetch them and settle in a turn of their own */
@@ -927,7 +930,7 @@ next:
 }
 
 void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                                              uint32_t inst, rc__hit *hits, int *found, int own_origins)
+                                              uint32_t inst, rc__hit *hits, int *found, uint32_t flags)
 {
     packet_trav T;
     uint32_t i;
@@ -937,8 +940,8 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
         return;
     }
     if (mesh->wide_count == 0) return;
-    if (!trav_init(&T, mesh, rays, n, hits, found, own_origins)) {
-        split_by_octant(mesh, rays, n, geom, inst, hits, found, own_origins);
+    if (!trav_init(&T, mesh, rays, n, hits, found, flags)) {
+        split_by_octant(mesh, rays, n, geom, inst, hits, found, flags);
         return;
     }
     while (trav_step(&T, mesh, geom, inst, 0)) {
@@ -947,20 +950,20 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
 
 void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                               int *const *found, int own_origins)
+                                               int *const *found, uint32_t flags)
 {
     packet_trav T[RC__PACKETS_IN_FLIGHT];
     uint32_t live = 0, k;
     if (packets > RC__PACKETS_IN_FLIGHT) packets = RC__PACKETS_IN_FLIGHT;
     if (packets == 1) {
-        RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0], own_origins);
+        RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0], flags);
         return;
     }
     for (k = 0; k < packets; ++k) {
-        if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k], own_origins))
+        if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k], flags))
             live |= 1u << k;
         else
-            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k], own_origins);
+            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k], flags);
     }
     /* take turns: while one packet's next node or leaf is on its way from
      * memory, the others work */
@@ -972,21 +975,21 @@ void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t pa
 
 #if defined(RC__PACKET_TWO_BUILDS) && !defined(RC__PACKET_AVX2_VARIANT)
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                               uint32_t inst, rc__hit *hits, int *found, int own_origins)
+                               uint32_t inst, rc__hit *hits, int *found, uint32_t flags)
 {
     if (rc__leaf4_have_avx2())
-        rc__mesh_intersect_packet_avx2(mesh, rays, n, geom, inst, hits, found, own_origins);
+        rc__mesh_intersect_packet_avx2(mesh, rays, n, geom, inst, hits, found, flags);
     else
-        rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found, own_origins);
+        rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found, flags);
 }
 
 void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                int *const *found, int own_origins)
+                                int *const *found, uint32_t flags)
 {
     if (rc__leaf4_have_avx2())
-        rc__mesh_intersect_packets_avx2(mesh, packets, rays, n, geom, inst, hits, found, own_origins);
+        rc__mesh_intersect_packets_avx2(mesh, packets, rays, n, geom, inst, hits, found, flags);
     else
-        rc__mesh_intersect_packets_sse2(mesh, packets, rays, n, geom, inst, hits, found, own_origins);
+        rc__mesh_intersect_packets_sse2(mesh, packets, rays, n, geom, inst, hits, found, flags);
 }
 #endif

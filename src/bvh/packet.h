@@ -19,19 +19,28 @@
 #define RC__PACKET_SIZE 32u
 
 /* An OnDn sensor whose origins all lie within this of its first (m) traces in
- * packets (own_origins below; the built-in backend decides): the beams of
+ * packets (RC__PACKET_OWN_ORIGINS below; the built-in backend decides): the beams of
  * one multi-beam LiDAR (an Ouster's 15.8 mm off its axis, other makes' few
  * centimetres). Rays from farther apart go one by one. */
 #define RC__PACKET_ORIGIN_SPREAD 0.25f
 
-/* rays[0..n) share org when own_origins is 0 (only rays[0].org is read for
- * the broadcast box tests); with 1, each ray has its own, and the box tests
- * grow by the largest offset between them (any offset is correct; offsets
- * much larger than the map's smallest boxes only cost time). hits[i].t holds
- * ray i's tmax on entry; found[i] is set to 1 where a hit was recorded
- * (found[] is not cleared). */
+/* flags of the traversals below */
+/* Each ray has its own origin. Without it rays[0..n) share org (only
+ * rays[0].org is read for the broadcast box tests); with it the box tests
+ * grow by the largest offset between the origins (any offset is correct;
+ * offsets much larger than the map's smallest boxes only cost time). */
+#define RC__PACKET_OWN_ORIGINS 1u
+/* A hit may keep RC__PRIM_PENDING for its prim id (its slot says which
+ * triangle): for a caller that writes no prim ids or normals and searches
+ * no other mesh after this one, so that no tie needs the id either. It then
+ * skips a read of bvh.refs a hit, a cache miss on large maps (rc__hit_settle
+ * gives the id). */
+#define RC__PACKET_PRIMS_PENDING 2u
+
+/* hits[i].t holds ray i's tmax on entry; found[i] is set to 1 where a hit
+ * was recorded (found[] is not cleared). flags: RC__PACKET_* above. */
 void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                               uint32_t inst, rc__hit *hits, int *found, int own_origins);
+                               uint32_t inst, rc__hit *hits, int *found, uint32_t flags);
 
 /* Several packets at once, taking turns node by node so that one packet's
  * memory fetches overlap the others' work (same answers as one by one):
@@ -40,7 +49,7 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
 #define RC__PACKETS_IN_FLIGHT 8u
 void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                int *const *found, int own_origins);
+                                int *const *found, uint32_t flags);
 
 /* Where leaf4.h has its AVX2 pairs (x86-64, GNU C) the traversal is built
  * twice (packet.c): for baseline x86-64 and for AVX2. The functions above
@@ -49,15 +58,15 @@ void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc
 #if defined(RC__LEAF4_PAIR_AVX2) && !defined(RC__PACKET_FORCE_SCALAR)
 #define RC__PACKET_TWO_BUILDS 1
 void rc__mesh_intersect_packet_sse2(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                                    uint32_t inst, rc__hit *hits, int *found, int own_origins);
+                                    uint32_t inst, rc__hit *hits, int *found, uint32_t flags);
 void rc__mesh_intersect_packets_sse2(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                      const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                     int *const *found, int own_origins);
+                                     int *const *found, uint32_t flags);
 void rc__mesh_intersect_packet_avx2(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom,
-                                    uint32_t inst, rc__hit *hits, int *found, int own_origins);
+                                    uint32_t inst, rc__hit *hits, int *found, uint32_t flags);
 void rc__mesh_intersect_packets_avx2(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                      const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
-                                     int *const *found, int own_origins);
+                                     int *const *found, uint32_t flags);
 #endif
 
 #endif
