@@ -325,19 +325,28 @@ uint32_t rc__mesh_order_key(const rc__mesh *mesh, const rc__ray *ray, float tmax
         float tn[4];
         if (stack[--sp].tnear > best) continue;
         mask = wide_box_test(n, &w, best, tn);
-        /* children in slot order: the search is over every box the ray
-         * meets above the depth, pruned by the nearest entry so far */
-        for (c = 0; c < 4; ++c) {
-            if (!((mask >> c) & 1u) || n->child[c] == RC__WIDE_EMPTY || tn[c] > best) continue;
-            if (n->count[c] != 0 || d + 1u >= depth) {
-                if (tn[c] < best || key == UINT32_MAX) {
-                    best = tn[c];
-                    key = node * 4u + c;
+        /* the search is over every box the ray meets above the depth,
+         * pruned by the nearest entry so far; the children go onto the
+         * stack nearest on top, so that a near subtree is found early and
+         * prunes the rest (1M sphere: -70% of the key's instructions
+         * against slot order; its time, a few per cent of a call, went
+         * unchanged on the AMD VM: it waits on memory) */
+        {
+            const uint32_t base = sp;
+            for (c = 0; c < 4; ++c) {
+                uint32_t j;
+                if (!((mask >> c) & 1u) || n->child[c] == RC__WIDE_EMPTY || tn[c] > best) continue;
+                if (n->count[c] != 0 || d + 1u >= depth) {
+                    if (tn[c] < best || key == UINT32_MAX) {
+                        best = tn[c];
+                        key = node * 4u + c;
+                    }
+                    continue;
                 }
-            } else {
-                stack[sp].node = n->child[c];
-                stack[sp].depth = d + 1u;
-                stack[sp].tnear = tn[c];
+                for (j = sp; j > base && stack[j - 1u].tnear < tn[c]; --j) stack[j] = stack[j - 1u];
+                stack[j].node = n->child[c];
+                stack[j].depth = d + 1u;
+                stack[j].tnear = tn[c];
                 ++sp;
             }
         }
