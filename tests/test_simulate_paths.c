@@ -6,7 +6,8 @@
  * centimetres apart, like a multi-beam LiDAR's), and all again with two
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
- * instance. On x86 also the packets' refinement of a tile's hits two at a
+ * instance, with or without prim ids asked for (without, the last mesh's
+ * hits may leave theirs pending). On x86 also the packets' refinement of a tile's hits two at a
  * time, against the one-hit function (the Embree backend's batches use it
  * too, with hits that carry no leaf slot). (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
@@ -62,8 +63,22 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
     uint32_t p, i, hits = 0, box_hits = 0, inst_hits = 0;
     poses[0] = rct_pose(0.0f, 0.0f, 0.0f);
     poses[1] = rct_pose(3.0f, -2.0f, 1.0f);
-    rct_buffers_alloc(&buf, (uint64_t)POSES * rays, RC_ATTR_HITS | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS);
+    rct_buffers_alloc(&buf, (uint64_t)POSES * rays,
+                      RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS);
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, POSES, &buf.res));
+    {
+        /* without prim ids (the last mesh's hits may keep theirs pending,
+         * RC__PACKET_PRIMS_PENDING): the same hits, ids and ranges */
+        rct_buffers ranges_only;
+        rct_buffers_alloc(&ranges_only, (uint64_t)POSES * rays,
+                          RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS);
+        RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, POSES, &ranges_only.res));
+        assert_memory_equal(ranges_only.res.ranges, buf.res.ranges, (size_t)POSES * rays * sizeof(float));
+        assert_memory_equal(ranges_only.res.hits, buf.res.hits, (size_t)POSES * rays);
+        assert_memory_equal(ranges_only.res.geom_ids, buf.res.geom_ids, (size_t)POSES * rays * sizeof(uint32_t));
+        assert_memory_equal(ranges_only.res.inst_ids, buf.res.inst_ids, (size_t)POSES * rays * sizeof(uint32_t));
+        rct_buffers_free(&ranges_only);
+    }
     for (p = 0; p < POSES; ++p)
         for (i = 0; i < rays; ++i) {
             const uint64_t at = (uint64_t)p * rays + i;
