@@ -235,6 +235,29 @@ static void test_pending_prims_equal_single(void **state)
     assert_true(pending_seen > 0);
 }
 
+/* A tie with a hit another mesh's search left pending: the key decides by
+ * geometry (the pending hit's 0 before 1) without resolving the pending prim
+ * against this mesh's refs, which its slot does not index (one entry here) */
+static void test_pending_prim_from_another_mesh(void **state)
+{
+    static const uint32_t refs_of_geom1[1] = {7u};
+    rc__hit h;
+    (void)state;
+    h.t = 2.0f;
+    h.prim = RC__PRIM_PENDING;
+    h.slot = 1000u;
+    h.geom = 0u;
+    h.inst = RC_INVALID_ID;
+    assert_int_equal(rc__hit_offer_slot(&h, 2.0f, refs_of_geom1, 0u, 1u, RC_INVALID_ID), 0);
+    assert_int_equal(h.prim, RC__PRIM_PENDING);
+    assert_int_equal(h.slot, 1000u);
+    /* the later geometry's nearer hit still wins */
+    assert_int_equal(rc__hit_offer_slot(&h, 1.5f, refs_of_geom1, 0u, 1u, RC_INVALID_ID), 1);
+    rc__hit_settle(&h, refs_of_geom1);
+    assert_int_equal(h.prim, 7u);
+    assert_int_equal(h.geom, 1u);
+}
+
 /* Both x86-64 builds, whichever the CPU selects (the AVX2 one where it has
  * AVX2). */
 static void test_both_builds_equal_single(void **state)
@@ -289,6 +312,7 @@ int main(void)
                                        cmocka_unit_test(test_packets_in_turns_equal_single),
                                        cmocka_unit_test(test_own_origins_equal_single),
                                        cmocka_unit_test(test_pending_prims_equal_single),
+                                       cmocka_unit_test(test_pending_prim_from_another_mesh),
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);

@@ -6,8 +6,8 @@
  * centimetres apart, like a multi-beam LiDAR's), and all again with two
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
- * instance, with or without prim ids asked for (without, the last mesh's
- * hits may leave theirs pending). On x86 also the packets' refinement of a tile's hits two at a
+ * instance, with or without prim ids asked for (without, the hits may
+ * leave theirs pending, also across meshes and instances). On x86 also the packets' refinement of a tile's hits two at a
  * time, against the one-hit function (the Embree backend's batches use it
  * too, with hits that carry no leaf slot). (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
@@ -67,7 +67,7 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
                       RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_PRIM_IDS | RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS);
     RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, POSES, &buf.res));
     {
-        /* without prim ids (the last mesh's hits may keep theirs pending,
+        /* without prim ids (the hits may keep theirs pending,
          * RC__PACKET_PRIMS_PENDING): the same hits, ids and ranges */
         rct_buffers ranges_only;
         rct_buffers_alloc(&ranges_only, (uint64_t)POSES * rays,

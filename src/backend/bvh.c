@@ -136,12 +136,8 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         }
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
-            /* the last search of a call that writes no prim ids leaves them
-             * pending (no later mesh's tie needs one) */
-            const uint32_t flags =
-                run->packet_flags | (run->prims_unneeded && g + 1u == scene->geom_count && scene->inst_count == 0
-                                         ? RC__PACKET_PRIMS_PENDING
-                                         : 0u);
+            /* a call that writes no prim ids leaves them pending */
+            const uint32_t flags = run->packet_flags | (run->prims_unneeded ? RC__PACKET_PRIMS_PENDING : 0u);
             if (group > 1 && ((run->large >> g) & 1u)) {
                 rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, flags);
             } else {

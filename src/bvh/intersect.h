@@ -285,7 +285,10 @@ static inline int rc__hit_offer_slot(rc__hit *h, float t, const uint32_t *refs, 
 {
     if (t > h->t) return 0;
     if (t == h->t) {
-        if (h->prim == RC__PRIM_PENDING) h->prim = refs[h->slot];
+        /* a hit another mesh's search left pending (RC__PACKET_PRIMS_PENDING)
+         * is not resolved against this mesh's refs: the key decides by
+         * instance or geometry before it reads the prim */
+        if (h->prim == RC__PRIM_PENDING && h->geom == geom && h->inst == inst) h->prim = refs[h->slot];
         if (!rc__hit_key_less(inst, geom, refs[slot], h)) return 0;
     }
     rc__hit_record(h, t, RC__PRIM_PENDING, slot, geom, inst);

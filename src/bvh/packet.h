@@ -30,11 +30,12 @@
  * grow by the largest offset between the origins (any offset is correct;
  * offsets much larger than the map's smallest boxes only cost time). */
 #define RC__PACKET_OWN_ORIGINS 1u
-/* A hit may keep RC__PRIM_PENDING for its prim id (its slot says which
- * triangle): for a caller that writes no prim ids or normals and searches
- * no other mesh after this one, so that no tie needs the id either. It then
+/* A hit may keep RC__PRIM_PENDING for its prim id (its slot and geometry say
+ * which triangle): for a caller that writes no prim ids or normals. It then
  * skips a read of bvh.refs a hit, a cache miss on large maps (rc__hit_settle
- * gives the id). */
+ * gives the id). A later search's tie needs no such id: the key compares
+ * instance and geometry first, and rc__hit_offer_slot resolves a pending id
+ * only against its own mesh. */
 #define RC__PACKET_PRIMS_PENDING 2u
 
 /* hits[i].t holds ray i's tmax on entry; found[i] is set to 1 where a hit
