@@ -50,8 +50,8 @@ typedef struct sim_run {
     uint32_t slices;                 /* tasks per pose */
     uint32_t tiles_per_slice;
     int packets;                     /* 1 when tiles go through the packet traversal */
-    uint32_t packet_flags;           /* RC__PACKET_OWN_ORIGINS when each ray has its own origin (OnDn) */
-    int prims_unneeded;              /* 1 when the call writes no prim ids or normals */
+    uint32_t packet_flags;           /* RC__PACKET_OWN_ORIGINS when each ray has its own origin (OnDn),
+                                      * RC__PACKET_PRIMS_PENDING when the call writes no prim ids or normals */
     uint32_t in_flight;              /* tiles traced at once: RC__PACKETS_IN_FLIGHT with a large mesh (1 when
                                       * ordered in a map the cache nearly holds), else 1 */
     int rays_by_mesh;                /* 1 when single rays go mesh by mesh, taking turns in large ones */
@@ -136,13 +136,12 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         }
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
-            /* a call that writes no prim ids leaves them pending */
-            const uint32_t flags = run->packet_flags | (run->prims_unneeded ? RC__PACKET_PRIMS_PENDING : 0u);
             if (group > 1 && ((run->large >> g) & 1u)) {
-                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, flags);
+                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, run->packet_flags);
             } else {
                 for (k = 0; k < group; ++k)
-                    rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k], flags);
+                    rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k],
+                                              run->packet_flags);
             }
         }
     } else if (run->rays_by_mesh) {
@@ -498,8 +497,8 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
      * sensor's beams: packet.c) (instances are searched ray by ray after
      * them); a scene of many meshes goes ray by ray through its top-level
      * tree instead of testing every mesh's root per tile. */
-    run.packet_flags = s->origins != NULL ? RC__PACKET_OWN_ORIGINS : 0u;
-    run.prims_unneeded = !(job->attributes & (RC_ATTR_PRIM_IDS | RC_ATTR_NORMALS));
+    run.packet_flags = (s->origins != NULL ? RC__PACKET_OWN_ORIGINS : 0u) |
+                       (job->attributes & (RC_ATTR_PRIM_IDS | RC_ATTR_NORMALS) ? 0u : RC__PACKET_PRIMS_PENDING);
     run.packets = (s->origins == NULL || s->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD) &&
                   job->scene->geom_count >= 1 && job->scene->geom_count <= RC__PACKET_MAX_MESHES;
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */

@@ -381,10 +381,9 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
 #if defined(RC__WIDE_BOX_SSE2)
 /* few_lanes_met for rays that share one origin (no RC__PACKET_OWN_ORIGINS):
  * each plane less the origin is then every lane's own (n - o), so it is
- * computed once for the node and each lane only multiplies it by its
- * reciprocals and takes the same maxima and minima, in the same order, as
- * rc__wide_box_lanes: the same bits and entry distances, without a lane's
- * six loads, subtractions and broadcasts of the origin. */
+ * computed once for the node and each lane runs only the rest of
+ * rc__wide_box_lanes' test (rc__wide_box_from_planes): the same bits and
+ * entry distances, without a lane's six loads and subtractions. */
 static RC__FORCE_INLINE uint32_t few_lanes_met_shared(const rc__wnode *n, const packet_lanes *L, uint32_t mask,
                                                      uint32_t met[4], float tn[4])
 {
@@ -394,21 +393,16 @@ static RC__FORCE_INLINE uint32_t few_lanes_met_shared(const rc__wnode *n, const 
     const __m128 pfx = _mm_sub_ps(_mm_load_ps(n->box[L->near_row[0] ^ 1u]), _mm_set1_ps(L->org_far[0]));
     const __m128 pfy = _mm_sub_ps(_mm_load_ps(n->box[L->near_row[1] ^ 1u]), _mm_set1_ps(L->org_far[1]));
     const __m128 pfz = _mm_sub_ps(_mm_load_ps(n->box[L->near_row[2] ^ 1u]), _mm_set1_ps(L->org_far[2]));
-    const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
     __m128i metv = _mm_loadu_si128((const __m128i *)(const void *)met);
     __m128 near = _mm_set1_ps(INFINITY); /* entry distances are never NaN: min(t0, inf) = t0 */
     while (mask) {
         const uint32_t lane = lowest_lane(mask);
-        const __m128 ix = _mm_set1_ps(L->ix[lane]), iy = _mm_set1_ps(L->iy[lane]), iz = _mm_set1_ps(L->iz[lane]);
-        __m128 t0 = _mm_max_ps(_mm_mul_ps(pnx, ix), _mm_setzero_ps());
-        __m128 t1 = _mm_min_ps(_mm_mul_ps(pfx, ix), _mm_set1_ps(L->tmax[lane]));
+        __m128 t0;
+        const __m128 in = rc__wide_box_from_planes(pnx, pny, pnz, pfx, pfy, pfz, _mm_set1_ps(L->ix[lane]),
+                                                   _mm_set1_ps(L->iy[lane]), _mm_set1_ps(L->iz[lane]),
+                                                   L->tmax[lane], &t0);
         mask &= mask - 1u;
-        t0 = _mm_max_ps(_mm_mul_ps(pny, iy), t0);
-        t1 = _mm_min_ps(_mm_mul_ps(pfy, iy), t1);
-        t0 = _mm_max_ps(_mm_mul_ps(pnz, iz), t0);
-        t1 = _mm_min_ps(_mm_mul_ps(pfz, iz), t1);
-        metv = _mm_or_si128(metv, _mm_and_si128(_mm_castps_si128(_mm_cmple_ps(t0, _mm_mul_ps(t1, scale))),
-                                                _mm_set1_epi32((int)(1u << lane))));
+        metv = _mm_or_si128(metv, _mm_and_si128(_mm_castps_si128(in), _mm_set1_epi32((int)(1u << lane))));
         near = _mm_min_ps(t0, near);
     }
     _mm_store_ps(tn, near);
@@ -530,8 +524,7 @@ typedef struct packet_trav {
     uint32_t n, sp, child, count, mask;
     uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
     uint32_t settling; /* 1 once the traversal is over and the prim ids are on their way */
-    uint32_t settle;   /* 0: hits may keep their prim pending (RC__PACKET_PRIMS_PENDING) */
-    uint32_t shared_origin; /* 1: every ray leaves from rays[0].org (no RC__PACKET_OWN_ORIGINS) */
+    uint32_t flags;    /* RC__PACKET_* (packet.h) */
     /* up to three pushes per level, and room for one node's children past the end */
     packet_entry stack[PACKET_STACK + 4u];
 } packet_trav;
@@ -678,8 +671,7 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
     if (!lanes_fill(&T->L, &T->P, rays, n, hits)) return 0;
     lanes_origins(&T->L, rays, n, (flags & RC__PACKET_OWN_ORIGINS) != 0u);
-    T->settle = !(flags & RC__PACKET_PRIMS_PENDING);
-    T->shared_origin = !(flags & RC__PACKET_OWN_ORIGINS);
+    T->flags = flags;
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     T->rays = rays;
     T->hits = hits;
@@ -841,7 +833,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             /* at most FEW_LANES live lanes: each meets the four boxes at once
              * (the single-ray test), cheaper than every box over all lanes */
 #if defined(RC__WIDE_BOX_SSE2)
-            if (T->shared_origin)
+            if (!(T->flags & RC__PACKET_OWN_ORIGINS))
                 maybe = few_lanes_met_shared(nd, L, mask, lanes_met, tn);
             else
 #endif
@@ -948,7 +940,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     do {
         if (T->sp == 0) {
             uint32_t i;
-            if (!T->settle) return 0;
+            if (T->flags & RC__PACKET_PRIMS_PENDING) return 0;
             if (interleaved) {
                 /* a prim id is a read from refs, a miss on a large map:
                  * prefetch them and settle in a turn of their own */

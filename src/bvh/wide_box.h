@@ -21,26 +21,41 @@
 #endif
 
 #if defined(RC__WIDE_BOX_SSE2)
+/* The slab test of one ray against four children, given each child's
+ * entry (pn) and exit (pf) planes less the ray's origin along x, y, z and
+ * the ray's reciprocal (broadcast): lane c all ones where it meets child c
+ * within [0, tmax], *near its entry distances. max/min return the second
+ * operand when the first is NaN (0 * inf: the origin on a plane of a
+ * parallel ray): such a plane imposes nothing. A packet's rays that share
+ * one origin take the planes once for all of them (packet.c). */
+static RC__FORCE_INLINE __m128 rc__wide_box_from_planes(__m128 pnx, __m128 pny, __m128 pnz, __m128 pfx, __m128 pfy,
+                                                        __m128 pfz, __m128 ix, __m128 iy, __m128 iz, float tmax,
+                                                        __m128 *near)
+{
+    __m128 t0 = _mm_max_ps(_mm_mul_ps(pnx, ix), _mm_setzero_ps());
+    __m128 t1 = _mm_min_ps(_mm_mul_ps(pfx, ix), _mm_set1_ps(tmax));
+    t0 = _mm_max_ps(_mm_mul_ps(pny, iy), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(pfy, iy), t1);
+    t0 = _mm_max_ps(_mm_mul_ps(pnz, iz), t0);
+    t1 = _mm_min_ps(_mm_mul_ps(pfz, iz), t1);
+    *near = t0;
+    return _mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE)));
+}
+
 /* rc__wide_box_test's answer before it is read out as bits: lane c all ones
  * where the ray meets child c (a packet's few lanes gather these: packet.c) */
 static RC__FORCE_INLINE __m128 rc__wide_box_lanes(const rc__wnode *n, const uint32_t near_row[3], const float org[3],
                                                   const float inv[3], float tmax, float tn[4])
 {
-    const float *nx = n->box[near_row[0]], *fx = n->box[near_row[0] ^ 1u];
-    const float *ny = n->box[near_row[1]], *fy = n->box[near_row[1] ^ 1u];
-    const float *nz = n->box[near_row[2]], *fz = n->box[near_row[2] ^ 1u];
     const __m128 ox = _mm_set1_ps(org[0]), oy = _mm_set1_ps(org[1]), oz = _mm_set1_ps(org[2]);
-    const __m128 ix = _mm_set1_ps(inv[0]), iy = _mm_set1_ps(inv[1]), iz = _mm_set1_ps(inv[2]);
-    /* max/min return the second operand when the first is NaN (0 * inf: the
-     * origin on a plane of a parallel ray): such a plane imposes nothing */
-    __m128 t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nx), ox), ix), _mm_setzero_ps());
-    __m128 t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fx), ox), ix), _mm_set1_ps(tmax));
-    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(ny), oy), iy), t0);
-    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fy), oy), iy), t1);
-    t0 = _mm_max_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(nz), oz), iz), t0);
-    t1 = _mm_min_ps(_mm_mul_ps(_mm_sub_ps(_mm_load_ps(fz), oz), iz), t1);
-    _mm_store_ps(tn, t0);
-    return _mm_cmple_ps(t0, _mm_mul_ps(t1, _mm_set1_ps(RC__SLAB_FAR_SCALE)));
+    __m128 near, in;
+    in = rc__wide_box_from_planes(
+        _mm_sub_ps(_mm_load_ps(n->box[near_row[0]]), ox), _mm_sub_ps(_mm_load_ps(n->box[near_row[1]]), oy),
+        _mm_sub_ps(_mm_load_ps(n->box[near_row[2]]), oz), _mm_sub_ps(_mm_load_ps(n->box[near_row[0] ^ 1u]), ox),
+        _mm_sub_ps(_mm_load_ps(n->box[near_row[1] ^ 1u]), oy), _mm_sub_ps(_mm_load_ps(n->box[near_row[2] ^ 1u]), oz),
+        _mm_set1_ps(inv[0]), _mm_set1_ps(inv[1]), _mm_set1_ps(inv[2]), tmax, &near);
+    _mm_store_ps(tn, near);
+    return in;
 }
 #endif
 
