@@ -14,6 +14,11 @@
 #include "bvh/intersect.h"
 
 #include <float.h>
+#include <stdint.h>
+
+#if defined(__AVX2__)
+#include <immintrin.h> /* rc__leaf4_vertices_full */
+#endif
 
 #if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
 #include <emmintrin.h>
@@ -41,15 +46,14 @@ static RC__FORCE_INLINE uint32_t rc__leaf4_vertices(const uint32_t *leaf_tris, c
     return count;
 }
 
-#if defined(__AVX2__) && !defined(RC__WIDE_FORCE_SCALAR)
-#include <immintrin.h>
-#include <stdint.h>
+#if defined(__AVX2__)
 /* rc__leaf4_vertices for a full leaf (count 4) in the AVX2 build: the same
  * twelve pointers, four at a time (each index widened and scaled in a
  * 64-bit lane; a stride in floats times 4 fits the multiply's 32-bit
- * operand, vertex_stride being a uint32_t of bytes): 15 instructions for
- * 48, but a few cycles more before the first pointer is ready, which only
- * a leaf tested by several lanes hides. */
+ * operand, vertex_stride being a uint32_t of bytes; an x86-64 pointer is its
+ * address as a 64-bit integer): 15 instructions for 48, but a few cycles
+ * more before the first pointer is ready, which only a leaf tested by
+ * several lanes hides. */
 static RC__FORCE_INLINE void rc__leaf4_vertices_full(const uint32_t *leaf_tris, const float *vertices, size_t stride,
                                                      uint32_t first, const float *v[4][3])
 {
