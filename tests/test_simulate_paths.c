@@ -106,8 +106,11 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
  * against rc__scene_hit_distance_d one at a time: the same doubles, for
  * tiles of 1..RC__PACKET_SIZE rays with misses and instance hits among
  * them, under a turned pose, each ray rep times in a row (rep 4: groups of
- * four on one triangle, the quad's shared-normal path). */
-static void check_distances_rep(const rc_scene *scene, const rc_sensor *s, uint32_t rays, uint32_t rep)
+ * four on one triangle, the quad's shared-normal path). With no_slots every
+ * third ray's hit has no leaf slot, as Embree's hits come; without, every
+ * hit keeps it, as the built-in traversal's do (a one-mesh scene's rows,
+ * scene_trace.c). */
+static void check_distances_rep(const rc_scene *scene, const rc_sensor *s, uint32_t rays, uint32_t rep, int no_slots)
 {
     const rc_pose pose = rct_pose_ypr(0.5f, -1.0f, 0.3f, 0.9, -0.3, 0.2);
     rc__xformf world;
@@ -129,7 +132,7 @@ static void check_distances_rep(const rc_scene *scene, const rc_sensor *s, uint3
             hits[i].prim = hits[i].geom = hits[i].inst = hits[i].slot = RC_INVALID_ID;
             found[i] = idx[i] % 7u != 3u && rc__scene_intersect(scene, &r, &hits[i]);
             /* as Embree's hits come: no leaf slot, the mesh's own triples */
-            if (idx[i] % 3u == 1u) hits[i].slot = RC_INVALID_ID;
+            if (no_slots && idx[i] % 3u == 1u) hits[i].slot = RC_INVALID_ID;
             insts += found[i] && hits[i].inst != RC_INVALID_ID;
         }
         rc__scene_hit_distances_d(scene, hits, found, n, &world, s->directions, idx, td);
@@ -148,8 +151,11 @@ static void check_distances_rep(const rc_scene *scene, const rc_sensor *s, uint3
 
 static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t rays)
 {
-    check_distances_rep(scene, s, rays, 1u);
-    check_distances_rep(scene, s, rays, 4u);
+    uint32_t no_slots;
+    for (no_slots = 0; no_slots < 2u; ++no_slots) {
+        check_distances_rep(scene, s, rays, 1u, (int)no_slots);
+        check_distances_rep(scene, s, rays, 4u, (int)no_slots);
+    }
 }
 #endif
 
