@@ -300,7 +300,7 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void columns4(__m128 r0,
  * went through the stack and were read three times each (100k sphere: 322
  * instructions a call). The values are distance_lanes4's: the same
  * operations on the same coordinates. */
-static __attribute__((target("avx2"))) void refine_four_rows(const rc__mesh *mesh, const rc__hit *hits,
+static RC__FORCE_INLINE __attribute__((target("avx2"))) void refine_four_rows(const rc__mesh *mesh, const rc__hit *hits,
                                                             const uint32_t *at, const rc__xformf *world,
                                                             const float *directions, const uint32_t *idx,
                                                             double *td)
@@ -325,6 +325,32 @@ static __attribute__((target("avx2"))) void refine_four_rows(const rc__mesh *mes
     distance_lanes4_corners(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz, world, hits, at, td);
 }
 
+/* rc__scene_hit_distances_d for a one-mesh scene without instances whose
+ * mesh has leaf-ordered triangles: its found rays four at a time in rows,
+ * the last few one at a time. 0 (td then partly written) when a found hit
+ * has no leaf slot (not the built-in traversal's): the caller starts over. */
+static __attribute__((target("avx2"))) int refine_rows_tile(const rc_scene *scene, const rc__hit *hits,
+                                                           const int *found, uint32_t n, const rc__xformf *world,
+                                                           const float *directions, const uint32_t *idx, double *td)
+{
+    const rc__mesh *one = &scene->geoms[0].mesh;
+    uint32_t own[4], k = 0, i;
+    for (i = 0; i < n; ++i) {
+        td[i] = 0.0;
+        own[k] = i;
+        k += found[i] != 0;
+        if (k < 4u) continue;
+        if ((hits[own[0]].slot == RC_INVALID_ID) | (hits[own[1]].slot == RC_INVALID_ID) |
+            (hits[own[2]].slot == RC_INVALID_ID) | (hits[own[3]].slot == RC_INVALID_ID))
+            return 0;
+        refine_four_rows(one, hits, own, world, directions, idx, td);
+        k = 0;
+    }
+    for (i = 0; i < k; ++i)
+        td[own[i]] = rc__scene_hit_distance_d(scene, &hits[own[i]], world, directions + (size_t)idx[own[i]] * 3u, NULL);
+    return 1;
+}
+
 /* ... of hits at[0 .. 4), all of it in VEX encoding */
 static __attribute__((target("avx2"))) void refine_four(const rc_scene *scene, const rc__hit *hits,
                                                        const uint32_t *at, const rc__xformf *world,
@@ -346,33 +372,10 @@ void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const
 #if defined(RC__LEAF4_PAIR_AVX2)
     if (rc__leaf4_have_avx2()) {
         group = 4u;
-        if (scene->geom_count == 1 && scene->inst_count == 0 && scene->geoms[0].mesh.leaf_tris) {
-            const rc__mesh *one = &scene->geoms[0].mesh;
-            /* one own mesh, no instances (the built-in backend's map): the
-             * found rays four at a time in rows, while their hits carry
-             * leaf slots */
-            int slots = 1;
-            for (i = 0; i < n; ++i) {
-                td[i] = 0.0;
-                own[k] = i;
-                k += found[i] != 0;
-                if (k < 4u) continue;
-                slots = (hits[own[0]].slot != RC_INVALID_ID) & (hits[own[1]].slot != RC_INVALID_ID) &
-                        (hits[own[2]].slot != RC_INVALID_ID) & (hits[own[3]].slot != RC_INVALID_ID);
-                if (!slots) break;
-                refine_four_rows(one, hits, own, world, directions, idx, td);
-                k = 0;
-            }
-            if (slots) {
-                for (i = 0; i < k; ++i)
-                    td[own[i]] = rc__scene_hit_distance_d(scene, &hits[own[i]], world,
-                                                          directions + (size_t)idx[own[i]] * 3u, NULL);
-                return;
-            }
-            /* a hit without its slot (not the built-in traversal's): the
-             * general loop below from the start */
-            k = 0;
-        }
+        /* one own mesh, no instances (the built-in backend's map): rows */
+        if (scene->geom_count == 1 && scene->inst_count == 0 && scene->geoms[0].mesh.leaf_tris &&
+            refine_rows_tile(scene, hits, found, n, world, directions, idx, td))
+            return;
     }
 #endif
     for (i = 0; i < n; ++i) {
