@@ -79,7 +79,11 @@ static RC__PREFETCH_INLINE void rc__prefetch_next(const rc__wnode *nodes, const 
         RC__PREFETCH(p);
         RC__PREFETCH(p + 64);
     } else {
-        RC__PREFETCH(leaf_tris + (size_t)3 * child);
+        /* a full leaf's 48 bytes of triples cross a cache line at half the
+         * slots (those at byte 32 or 48 of a line): its last byte too */
+        const char *p = (const char *)(leaf_tris + (size_t)3 * child);
+        RC__PREFETCH(p);
+        RC__PREFETCH(p + 12u * count - 1u);
     }
 }
 
