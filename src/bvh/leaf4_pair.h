@@ -41,19 +41,6 @@
 #define PAIR_ROW(lo, hi) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_loadu_ps(lo)), _mm_loadu_ps(hi), 1)
 #define PAIR_SET(a, b) _mm256_insertf128_ps(_mm256_castps128_ps256(_mm_set1_ps(a)), _mm_set1_ps(b), 1)
 
-/* The eight lanes' answers as the two rays' rc__leaf4_out */
-static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_pair_split(uint32_t hit, uint32_t redo, __m256 t,
-                                                                                  rc__leaf4_out *oa,
-                                                                                  rc__leaf4_out *ob)
-{
-    oa->hit = hit & 15u;
-    ob->hit = hit >> 4;
-    oa->redo = redo & 15u;
-    ob->redo = redo >> 4;
-    _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
-    _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
-}
-
 /* rc__leaf4_test_soa for ra into *oa and rb into *ob */
 static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_pair(
     const rc__ray *ra, const rc__ray *rb, const rc__leaf4_soa *s, uint32_t count, rc__leaf4_out *oa,
@@ -70,7 +57,12 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_
                 PAIR_SET(ra->org[ra->ky], rb->org[rb->ky]), PAIR_SET(ra->org[ra->kz], rb->org[rb->kz]),
                 PAIR_SET(ra->sx, rb->sx), PAIR_SET(ra->sy, rb->sy), PAIR_SET(ra->sz, rb->sz), all4 | all4 << 4, &hit,
                 &redo, &t);
-    rc__leaf4_pair_split(hit, redo, t, oa, ob);
+    oa->hit = hit & 15u;
+    ob->hit = hit >> 4;
+    oa->redo = redo & 15u;
+    ob->redo = redo >> 4;
+    _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
+    _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
 }
 
 /* The leaf's nine rows along axes k[0..2] (kx, ky, kz), each in both
@@ -102,7 +94,12 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_rows
     leaf8_lanes(rows->r[0], rows->r[1], rows->r[2], rows->r[3], rows->r[4], rows->r[5], rows->r[6], rows->r[7],
                 rows->r[8], ox, oy, oz, PAIR_SET(ra->sx, rb->sx), PAIR_SET(ra->sy, rb->sy), PAIR_SET(ra->sz, rb->sz),
                 all4 | all4 << 4, &hit, &redo, &t);
-    rc__leaf4_pair_split(hit, redo, t, oa, ob);
+    oa->hit = hit & 15u;
+    ob->hit = hit >> 4;
+    oa->redo = redo & 15u;
+    ob->redo = redo >> 4;
+    _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
+    _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
 }
 #undef PAIR_ROW
 #undef PAIR_SET
