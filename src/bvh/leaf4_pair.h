@@ -64,43 +64,6 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_soa_
     _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
     _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
 }
-
-/* The leaf's nine rows along axes k[0..2] (kx, ky, kz), each in both
- * halves: for rays that share their axes, once a leaf */
-typedef struct rc__leaf4_pair_rows {
-    __m256 r[9];
-} rc__leaf4_pair_rows;
-
-static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_pair_rows_fill(const rc__leaf4_soa *s,
-                                                                                      const uint32_t k[3],
-                                                                                      rc__leaf4_pair_rows *rows)
-{
-    uint32_t v, a;
-    for (v = 0; v < 3u; ++v)
-        for (a = 0; a < 3u; ++a) rows->r[3u * v + a] = _mm256_broadcast_ps((const __m128 *)(const void *)s->c[v][k[a]]);
-}
-
-/* rc__leaf4_test_soa_pair for two rays whose kx, ky, kz are those rows
- * were filled for and whose origins are (ox, oy, oz) along them (the
- * packet's shared origin): the same inputs to the same lanes, so the same
- * bits, without gathering each ray's rows and origin */
-static RC__FORCE_INLINE __attribute__((target("avx2"))) void rc__leaf4_test_rows_pair(
-    const rc__leaf4_pair_rows *rows, __m256 ox, __m256 oy, __m256 oz, const rc__ray *ra, const rc__ray *rb,
-    uint32_t count, rc__leaf4_out *oa, rc__leaf4_out *ob)
-{
-    const uint32_t all4 = (1u << count) - 1u;
-    __m256 t;
-    uint32_t hit, redo;
-    leaf8_lanes(rows->r[0], rows->r[1], rows->r[2], rows->r[3], rows->r[4], rows->r[5], rows->r[6], rows->r[7],
-                rows->r[8], ox, oy, oz, PAIR_SET(ra->sx, rb->sx), PAIR_SET(ra->sy, rb->sy), PAIR_SET(ra->sz, rb->sz),
-                all4 | all4 << 4, &hit, &redo, &t);
-    oa->hit = hit & 15u;
-    ob->hit = hit >> 4;
-    oa->redo = redo & 15u;
-    ob->redo = redo >> 4;
-    _mm_storeu_ps(oa->t, _mm256_castps256_ps128(t));
-    _mm_storeu_ps(ob->t, _mm256_extractf128_ps(t, 1));
-}
 #undef PAIR_ROW
 #undef PAIR_SET
 #endif

@@ -83,10 +83,6 @@ typedef struct packet_lanes {
     /* the origin the broadcast tests take for near (entry) and far (exit)
      * planes: both the rays' shared origin, or moved apart (lanes_origins) */
     float org_near[3], org_far[3];
-    /* 1 when every ray has the same kx, ky, kz (k[0..2]) and the rays share
-     * one origin: then a leaf's rows and the origin along them are the same
-     * for every lane (the AVX2 pairs take them once a leaf) */
-    uint32_t shared_axes, k[3];
 } packet_lanes;
 
 
@@ -667,30 +663,6 @@ static void lanes_origins(packet_lanes *L, const rc__ray *rays, uint32_t n, int 
     }
 }
 
-/* L->shared_axes and L->k (above), from P's bounds on the reciprocals: a
- * ray's kz is its direction's largest component (rc__ray_prepare), and an
- * axis a whose largest |1 / d| over the lanes lies below the smallest of
- * each other axis is every lane's largest |d| (a reciprocal's rounding never
- * reverses an order). kx and ky then follow from kz and the sign along it,
- * which one octant shares. Ties, and bounds that are not usable (a NaN may
- * hide from them), leave shared_axes 0: the pairs then gather each lane's
- * rows, with the same results. */
-static void lanes_axes(packet_lanes *L, const packet_bounds *P, const rc__ray *rays, int own_origins)
-{
-    float lo[3], hi[3];
-    uint32_t k;
-    for (k = 0; k < 3; ++k) {
-        const float a = fabsf(P->ilo[k]), b = fabsf(P->ihi[k]);
-        lo[k] = a < b ? a : b;
-        hi[k] = a < b ? b : a;
-    }
-    L->k[0] = (uint32_t)rays[0].kx;
-    L->k[1] = (uint32_t)rays[0].ky;
-    L->k[2] = (uint32_t)rays[0].kz;
-    k = L->k[2];
-    L->shared_axes = P->usable && !own_origins && k < 3u && hi[k] < lo[(k + 1u) % 3u] && hi[k] < lo[(k + 2u) % 3u];
-}
-
 /* Starts T on the root. 0 when the packet cannot run as one (empty, too
  * large, mixed octants, no tree): the caller takes the rays another way. */
 static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, uint32_t n, rc__hit *hits,
@@ -699,7 +671,6 @@ static int trav_init(packet_trav *T, const rc__mesh *mesh, const rc__ray *rays, 
     if (n == 0 || n > LANES || mesh->wide == NULL || mesh->wide_count == 0) return 0;
     if (!lanes_fill(&T->L, &T->P, rays, n, hits)) return 0;
     lanes_origins(&T->L, rays, n, (flags & RC__PACKET_OWN_ORIGINS) != 0u);
-    lanes_axes(&T->L, &T->P, rays, (flags & RC__PACKET_OWN_ORIGINS) != 0u);
     T->flags = flags;
     T->mask = (n >= 32u ? 0u : (1u << n)) - 1u;
     T->rays = rays;
@@ -956,27 +927,6 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         } else
 #endif
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
-#if defined(RC__PACKET_AVX2)
-        if (L->shared_axes) {
-            /* rays with one origin and the same axes: the leaf's rows and
-             * the origin along them once for all pairs (a pair otherwise
-             * gathers eighteen rows and six origin coordinates); a last
-             * odd lane goes on below */
-            rc__leaf4_pair_rows rows;
-            const __m256 ox = _mm256_set1_ps(rays[0].org[L->k[0]]), oy = _mm256_set1_ps(rays[0].org[L->k[1]]);
-            const __m256 oz = _mm256_set1_ps(rays[0].org[L->k[2]]);
-            rc__leaf4_pair_rows_fill(&soa, L->k, &rows);
-            while (m & (m - 1u)) {
-                const uint32_t lane = lowest_lane(m), lane2 = lowest_lane(m & (m - 1u));
-                rc__leaf4_out lo2;
-                m &= m - 1u;
-                m &= m - 1u;
-                rc__leaf4_test_rows_pair(&rows, ox, oy, oz, &rays[lane], &rays[lane2], n_tri, &lo, &lo2);
-                leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, &shrunk);
-                leaf_lane_offer(T, mesh, vt, child, lane2, &lo2, &known, &flat, geom, inst, &shrunk);
-            }
-        }
-#endif
         while (m) {
             const uint32_t lane = lowest_lane(m);
             m &= m - 1u;
