@@ -190,24 +190,36 @@ static size_t required(const rcu_mesh *m, uint32_t flags, int with_instance)
  * RC_ERR_OUT_OF_MEMORY and no crash or leak. */
 static void test_arena_sizing_exact(void **state)
 {
-    rcu_mesh m;
-    uint32_t flags;
+    rcu_mesh meshes[2];
+    uint32_t flags, k, i;
     int inst;
     (void)state;
-    assert_int_equal(rcu_mesh_uv_sphere(10.0f, 37, 19, &m), 0);
-    for (inst = 0; inst < 2; ++inst)
-        for (flags = 0; flags < 2; ++flags) {
-            size_t need = required(&m, flags, inst);
-            assert_int_equal(build_in(need, &m, flags, inst), RC_OK);
-            /* With one scene the sum is exact. With a second (instancing) scene
-             * the first one's commit scratch is free again when the second
-             * commits, so the sum is an upper bound by that much. */
-            if (!inst) {
-                assert_int_equal(build_in(need - 1, &m, flags, inst), RC_ERR_OUT_OF_MEMORY);
-                assert_int_equal(build_in(need - 16, &m, flags, inst), RC_ERR_OUT_OF_MEMORY);
+    assert_int_equal(rcu_mesh_uv_sphere(10.0f, 37, 19, &meshes[0]), 0);
+    /* the same triangles among many more vertices than they use: a copy's
+     * renumbering (rc__mesh_order_vertices) then needs more commit scratch
+     * than the builder, and the query must count it */
+    assert_int_equal(rcu_mesh_reserve(&meshes[1], meshes[0].vertex_count + 20000u, meshes[0].triangle_count), 0);
+    memcpy(meshes[1].vertices, meshes[0].vertices, 12u * meshes[0].vertex_count);
+    for (i = 0; i < 3u * 20000u; ++i) meshes[1].vertices[3u * meshes[0].vertex_count + i] = (float)(i % 7u);
+    memcpy(meshes[1].indices, meshes[0].indices, 12u * meshes[0].triangle_count);
+    meshes[1].vertex_count = meshes[0].vertex_count + 20000u;
+    meshes[1].triangle_count = meshes[0].triangle_count;
+    for (k = 0; k < 2u; ++k)
+        for (inst = 0; inst < 2; ++inst)
+            for (flags = 0; flags < 2; ++flags) {
+                const rcu_mesh *m = &meshes[k];
+                size_t need = required(m, flags, inst);
+                assert_int_equal(build_in(need, m, flags, inst), RC_OK);
+                /* With one scene the sum is exact. With a second (instancing) scene
+                 * the first one's commit scratch is free again when the second
+                 * commits, so the sum is an upper bound by that much. */
+                if (!inst) {
+                    assert_int_equal(build_in(need - 1, m, flags, inst), RC_ERR_OUT_OF_MEMORY);
+                    assert_int_equal(build_in(need - 16, m, flags, inst), RC_ERR_OUT_OF_MEMORY);
+                }
             }
-        }
-    rcu_mesh_free(&m);
+    rcu_mesh_free(&meshes[0]);
+    rcu_mesh_free(&meshes[1]);
 }
 
 /* Bytes per triangle of the committed structure (the issue's budget: at most

@@ -358,7 +358,10 @@ RC_API rc_status rc_scene_create(rc_context *ctx, const rc_scene_desc *desc, rc_
 RC_API rc_status rc_scene_destroy(rc_scene *scene);
 
 #define RC_MESH_REFERENCE 0u  /* default: the arrays are used in place; keep them alive and unchanged */
-#define RC_MESH_COPY      1u  /* the arrays are copied into the arena */
+#define RC_MESH_COPY      1u  /* the arrays are copied into the arena; the built-in backend's
+                                 commit renumbers the copy's vertices in the order its tree
+                                 reads them (triangles, their order, corners and every result
+                                 unchanged), so a poor vertex order costs nothing */
 
 typedef struct rc_mesh_desc {
     uint32_t struct_size;
@@ -495,7 +498,10 @@ RC_API rc_status rc_scene_load_baked(rc_context *ctx, const void *blob, size_t b
 
 /* Geometry geom_id of a baked map as a mesh desc that references the blob
  * (vertex_stride 16), e.g. to hand the map to code of your own. Checks the
- * header and that geometry's offsets, not the checksum. */
+ * header and that geometry's offsets, not the checksum. A mesh that was
+ * copied (RC_MESH_COPY) comes back with its vertices renumbered as the
+ * commit ordered them: the same triangles, in the same order, corner by
+ * corner. */
 RC_API rc_status rc_baked_get_mesh(const void *blob, size_t bytes, uint32_t geom_id, rc_mesh_desc *mesh,
                                    uint32_t *geometry_count);
 

@@ -67,6 +67,31 @@ void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out)
     }
 }
 
+size_t rc__mesh_order_scratch_bytes(uint64_t vertex_count)
+{
+    /* the new number of each vertex, and a copy of the old array */
+    return (size_t)vertex_count * (sizeof(uint32_t) + 3u * sizeof(float));
+}
+
+void rc__mesh_order_vertices(const rc__mesh *mesh, float *vertices, uint32_t *indices, void *scratch)
+{
+    const uint32_t vertex_count = mesh->vertex_count;
+    uint32_t *const renumber = (uint32_t *)scratch;
+    float *const old = (float *)(void *)(renumber + vertex_count);
+    uint32_t next = 0, j, k;
+    for (j = 0; j < vertex_count; ++j) renumber[j] = UINT32_MAX;
+    for (j = 0; j < mesh->triangle_count; ++j) {
+        const uint32_t *tri = indices + (size_t)3 * mesh->bvh.refs[j];
+        for (k = 0; k < 3u; ++k)
+            if (renumber[tri[k]] == UINT32_MAX) renumber[tri[k]] = next++;
+    }
+    for (j = 0; j < vertex_count; ++j)
+        if (renumber[j] == UINT32_MAX) renumber[j] = next++;
+    memcpy(old, vertices, (size_t)vertex_count * 3u * sizeof(float));
+    for (j = 0; j < vertex_count; ++j) memcpy(vertices + (size_t)3 * renumber[j], old + (size_t)3 * j, 3u * sizeof(float));
+    for (j = 0; j < 3u * mesh->triangle_count; ++j) indices[j] = renumber[indices[j]];
+}
+
 void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out)
 {
     uint32_t j;

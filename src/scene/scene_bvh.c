@@ -22,6 +22,7 @@ typedef struct accel_layout {
     size_t bytes;                                       /* block payload */
     size_t scratch_items;                               /* largest build */
     size_t scratch_nodes;                               /* binary nodes built in scratch (wide) */
+    size_t scratch_front;                               /* scratch bytes before those nodes */
     size_t scratch_bytes;
 } accel_layout;
 
@@ -56,9 +57,14 @@ static void layout_of(const rc_scene_desc *d, int wide, accel_layout *l)
      * wide nodes (wide) start on a 64-byte line */
     l->bytes = l->wide_offset + l->wide_nodes * sizeof(rc__wnode) + 64u;
     l->scratch_items = t > items ? t : items;
-    l->scratch_bytes = align16(l->scratch_items * sizeof(rc__aabb)) +
-                       rc__bvh_build_scratch_bytes((uint32_t)l->scratch_items) +
-                       l->scratch_nodes * sizeof(rc__bvh_node);
+    l->scratch_front = align16(l->scratch_items * sizeof(rc__aabb)) +
+                       rc__bvh_build_scratch_bytes((uint32_t)l->scratch_items);
+    /* a copied mesh's vertices are put in leaf order (rc__mesh_order_vertices)
+     * in the front part once its tree is built: room for the most a scene
+     * copies (a mesh of few triangles may have many vertices) */
+    if (wide && rc__mesh_order_scratch_bytes(d->max_vertices) > l->scratch_front)
+        l->scratch_front = align16(rc__mesh_order_scratch_bytes(d->max_vertices));
+    l->scratch_bytes = l->scratch_front + l->scratch_nodes * sizeof(rc__bvh_node);
 }
 
 static size_t commit_bytes(const rc_scene_desc *desc, int wide)
@@ -190,8 +196,7 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
     }
     item_bounds = (rc__aabb *)(void *)scratch;
     builder_scratch = scratch + align16(l.scratch_items * sizeof(rc__aabb));
-    scratch_nodes = (rc__bvh_node *)(void *)((unsigned char *)builder_scratch +
-                                             rc__bvh_build_scratch_bytes((uint32_t)l.scratch_items));
+    scratch_nodes = (rc__bvh_node *)(void *)(scratch + l.scratch_front);
     base = (unsigned char *)scene->top_block;
     if (wide) {
         /* wide nodes on a 64-byte line: each node is two whole lines */
@@ -219,6 +224,12 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             rc__mesh_triangle_bounds(mesh, item_bounds);
             rc__bvh_build_mt(item_bounds, mesh->triangle_count, RC__BVH_MESH_LEAF_SIZE, builder_scratch, &mesh->bvh,
                              ctx->pool, progress, user);
+            /* a copy is the scene's own: its vertices in the order the
+             * leaves read them (the item bounds and the builder's scratch
+             * are spent; the binary nodes after them are still needed) */
+            if (wide && (geo->flags & RC_MESH_COPY) && mesh->stride == 3u)
+                rc__mesh_order_vertices(mesh, (float *)(uintptr_t)mesh->vertices, (uint32_t *)(uintptr_t)mesh->indices,
+                                        scratch);
             rc__mesh_fill_leaf_tris(mesh, lt);
             rc__mesh_fold_flats(mesh, lt);
             mesh->flats_folded = 1;

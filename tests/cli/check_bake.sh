@@ -34,6 +34,12 @@ run 0 "" "$RC" bench --map sphere.rcmap --poses poses.bin --repeat 1 --threads 2
     --ranges-out one.f32 $BACKEND
 grep -Eq '"poses_per_call":1[,}]' out.txt || { cat out.txt; fail "bench reports poses_per_call 1"; }
 cmp ply.f32 one.f32 || fail "one pose a call changed the ranges"
+# the map copied into the arena (the built-in backend renumbers the copy's
+# vertices at commit) gives the same ranges, and bench says how it went in
+run 0 "" "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 --mesh copy --ranges-out copy.f32 $BACKEND
+grep -Eq '"mesh":"copy"[,}]' out.txt || { cat out.txt; fail "bench reports mesh copy"; }
+cmp ply.f32 copy.f32 || fail "a copied map changed the ranges"
+run 2 "--mesh: expected reference or copy, got 'flash'" "$RC" bench --mesh flash
 run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" bench --poses-per-call 0
 # an explicit --poses-per-call is taken as given, past the 128 MiB of ranges
 # that size the default (82 D435 scans): a GPU wants 10,000 VLP-16 scans a call

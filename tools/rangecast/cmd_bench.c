@@ -58,6 +58,8 @@ static void usage(FILE *f)
         "                     (RC_RESULTS_ON_DEVICE), so the download is not timed\n"
         "  --build-quality Q  balanced (default), fast, high, compact: rc_scene_desc.build_quality\n"
         "                     (Embree's build; the built-in backend has one build)\n"
+        "  --mesh M           reference (default): the map's arrays used in place; copy: copied\n"
+        "                     into the arena (RC_MESH_COPY; bytes_per_triangle then counts the copy)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
@@ -72,7 +74,7 @@ static void usage(FILE *f)
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
         "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
-        "build_quality baked_map_bytes vulkan_traversal poses_per_call results_on_device.\n"
+        "build_quality baked_map_bytes vulkan_traversal poses_per_call results_on_device mesh.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
         "A baked map (.rcmap, rangecast bake) is loaded in place: build_s is then the load\n"
@@ -287,6 +289,14 @@ static int parse_args(int argc, char **argv, bench_args *a)
                 return rcp_usage_error(cmd, "--vulkan-traversal: expected compute or ray-query, got '%s'", v), -1;
         } else if (strcmp(argv[i], "--results-on-device") == 0) {
             a->on_device = 1;
+        } else if (OPT("--mesh")) {
+            if (r < 0) return -1;
+            if (strcmp(v, "reference") == 0)
+                rcp_mesh_flags = RC_MESH_REFERENCE;
+            else if (strcmp(v, "copy") == 0)
+                rcp_mesh_flags = RC_MESH_COPY;
+            else
+                return rcp_usage_error(cmd, "--mesh: expected reference or copy, got '%s'", v), -1;
         } else if (OPT("--build-quality")) {
             if (r < 0) return -1;
             if (rcp_parse_build_quality(cmd, v, &rcp_build_quality) != 0) return -1;
@@ -739,7 +749,8 @@ int rcp_cmd_bench(int argc, char **argv)
                    (rcp_context_flags & RC_CONTEXT_VULKAN_RAY_QUERY) ? "ray-query" : "compute");
         else
             printf(",\"vulkan_traversal\":null");
-        printf(",\"poses_per_call\":%u,\"results_on_device\":%s}\n", batch, a.on_device ? "true" : "false");
+        printf(",\"poses_per_call\":%u,\"results_on_device\":%s,\"mesh\":\"%s\"}\n", batch,
+               a.on_device ? "true" : "false", rcp_mesh_flags == RC_MESH_COPY ? "copy" : "reference");
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;

@@ -226,6 +226,7 @@ const char *rcp_build_quality_name(uint32_t quality)
 }
 
 uint32_t rcp_build_quality = RC_BUILD_BALANCED;
+uint32_t rcp_mesh_flags = RC_MESH_REFERENCE;
 
 static const char *const sensor_names[] = {"vlp16",       "vlp16-360", "os1-64", "d435",
                                            "livox-mid40", "ust-10lx",  "lds-01"};
@@ -252,8 +253,9 @@ static rc_scene_desc scene_desc_for(const rcu_mesh *mesh)
     rc_scene_desc sd = rc_scene_desc_default();
     sd.max_geometries = 1;
     sd.max_triangles = mesh->triangle_count;
-    sd.max_vertices = 0;          /* the mesh is referenced in place, not copied */
-    sd.max_copied_triangles = 0;
+    /* referenced in place (the default), or room for its copy (bench --mesh copy) */
+    sd.max_vertices = rcp_mesh_flags == RC_MESH_COPY ? mesh->vertex_count : 0;
+    sd.max_copied_triangles = rcp_mesh_flags == RC_MESH_COPY ? mesh->triangle_count : 0;
     sd.build_quality = rcp_build_quality;
     return sd;
 }
@@ -425,7 +427,7 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
         rc_mesh_desc md = rc_mesh_desc_default();
         uint32_t geom = 0;
         double t0;
-        md.flags = RC_MESH_REFERENCE;
+        md.flags = rcp_mesh_flags;
         md.vertices = mesh->vertices;
         md.vertex_count = mesh->vertex_count;
         md.indices = mesh->indices;

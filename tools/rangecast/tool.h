@@ -86,6 +86,9 @@ extern const char *rcp_device;
 extern uint32_t rcp_context_flags;
 /* --build-quality of bench: the scene's rc_scene_desc.build_quality (RC_BUILD_*). */
 extern uint32_t rcp_build_quality;
+/* --mesh of bench: how the map's mesh is handed in, RC_MESH_REFERENCE (the
+ * default: used in place) or RC_MESH_COPY (copied into the arena). */
+extern uint32_t rcp_mesh_flags;
 /* 1 (bench, simulate): the contexts get RC_SIMULATE_SCRATCH_PER_THREAD a
  * thread beyond the exact requirements, so that calls on maps larger than the
  * cache run ordered; 0 (info, demo): the exact figure. */
