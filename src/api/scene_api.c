@@ -66,6 +66,20 @@ static rc_status check_scene_desc(rc_context *ctx, const rc_scene_desc *desc)
                  desc->origin[2]);
     RC_RETURN_IF(ctx, desc->max_instances > 0x00FFFFFFu || desc->max_geometries > 0x00FFFFFFu,
                  RC_ERR_INVALID_ARGUMENT, "desc->max_geometries/max_instances above 16777215");
+    /* The size arithmetic runs in size_t: on a 32-bit build, capacities whose
+     * bytes could pass the address space would wrap it (a tiny block for a
+     * large copy). Every backend's scene takes well under this bound (the
+     * built-in backend's commit peaks near 112 bytes a triangle). */
+    {
+        const uint64_t bound = desc->max_triangles * 256u + desc->max_vertices * 32u +
+                               desc->max_copied_triangles * 16u +
+                               ((uint64_t)desc->max_geometries + desc->max_instances + 2u) * 1024u + (1u << 20);
+        RC_RETURN_IF(ctx, bound > (uint64_t)SIZE_MAX, RC_ERR_INVALID_ARGUMENT,
+                     "desc->max_triangles (%llu) and max_vertices (%llu) could need more bytes than this %u-bit "
+                     "build can address",
+                     (unsigned long long)desc->max_triangles, (unsigned long long)desc->max_vertices,
+                     (unsigned)(sizeof(size_t) * 8u));
+    }
     return RC_OK;
 }
 
