@@ -75,10 +75,8 @@ static rc_status check_scene_desc(rc_context *ctx, const rc_scene_desc *desc)
                                desc->max_copied_triangles * 16u +
                                ((uint64_t)desc->max_geometries + desc->max_instances + 2u) * 1024u + (1u << 20);
         RC_RETURN_IF(ctx, bound > (uint64_t)SIZE_MAX, RC_ERR_INVALID_ARGUMENT,
-                     "desc->max_triangles (%llu) and max_vertices (%llu) could need more bytes than this %u-bit "
-                     "build can address",
-                     (unsigned long long)desc->max_triangles, (unsigned long long)desc->max_vertices,
-                     (unsigned)(sizeof(size_t) * 8u));
+                     "desc->max_triangles %llu, max_vertices %llu: more bytes than this build can address",
+                     (unsigned long long)desc->max_triangles, (unsigned long long)desc->max_vertices);
     }
     return RC_OK;
 }

@@ -67,6 +67,7 @@ void rc__mesh_triangle_bounds(const rc__mesh *mesh, rc__aabb *out)
     }
 }
 
+#if defined(RC__ORDER_COPIES)
 size_t rc__mesh_order_scratch_bytes(uint64_t vertex_count)
 {
     /* the new number of each vertex, and a copy of the old array */
@@ -91,6 +92,7 @@ void rc__mesh_order_vertices(const rc__mesh *mesh, float *vertices, uint32_t *in
     for (j = 0; j < vertex_count; ++j) memcpy(vertices + (size_t)3 * renumber[j], old + (size_t)3 * j, 3u * sizeof(float));
     for (j = 0; j < 3u * mesh->triangle_count; ++j) indices[j] = renumber[indices[j]];
 }
+#endif
 
 void rc__mesh_fill_leaf_tris(const rc__mesh *mesh, uint32_t *out)
 {

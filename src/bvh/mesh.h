@@ -72,8 +72,14 @@ void rc__rays_prepare_turned(const float r[9], const float org[3], const float *
  * with a shuffled vertex array traced 9% slower without it,
  * docs/benchmarks.md). scratch holds rc__mesh_order_scratch_bytes(vertex
  * count) bytes, 4-byte aligned. */
+#if !defined(__OPTIMIZE_SIZE__)
+/* Left out of -Os builds (the static core for small boards, whose size
+ * budget it would pass, docs/benchmarks.md): a copy then keeps the caller's
+ * numbering, with the same results. */
+#define RC__ORDER_COPIES 1
 size_t rc__mesh_order_scratch_bytes(uint64_t vertex_count);
 void rc__mesh_order_vertices(const rc__mesh *mesh, float *vertices, uint32_t *indices, void *scratch);
+#endif
 
 /* Fills out (3 per slot, leaf order) with the vertex indices of triangle
  * refs[slot]. */

@@ -62,8 +62,10 @@ static void layout_of(const rc_scene_desc *d, int wide, accel_layout *l)
     /* a copied mesh's vertices are put in leaf order (rc__mesh_order_vertices)
      * in the front part once its tree is built: room for the most a scene
      * copies (a mesh of few triangles may have many vertices) */
+#if defined(RC__ORDER_COPIES)
     if (wide && rc__mesh_order_scratch_bytes(d->max_vertices) > l->scratch_front)
         l->scratch_front = align16(rc__mesh_order_scratch_bytes(d->max_vertices));
+#endif
     l->scratch_bytes = l->scratch_front + l->scratch_nodes * sizeof(rc__bvh_node);
 }
 
@@ -227,9 +229,11 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             /* a copy is the scene's own: its vertices in the order the
              * leaves read them (the item bounds and the builder's scratch
              * are spent; the binary nodes after them are still needed) */
+#if defined(RC__ORDER_COPIES)
             if (wide && (geo->flags & RC_MESH_COPY) && mesh->stride == 3u)
                 rc__mesh_order_vertices(mesh, (float *)(uintptr_t)mesh->vertices, (uint32_t *)(uintptr_t)mesh->indices,
                                         scratch);
+#endif
             rc__mesh_fill_leaf_tris(mesh, lt);
             rc__mesh_fold_flats(mesh, lt);
             mesh->flats_folded = 1;
