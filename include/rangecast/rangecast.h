@@ -347,7 +347,9 @@ RC_API rc_scene_desc rc_scene_desc_default(void);
  * after rc_scene_add_mesh rebuilds every mesh and needs the whole reservation
  * again, so leave that room free (rc_scene_update_mesh only refits, in place).
  * Embree and Vulkan also allocate outside the arena (rc_memory_stats;
- * rc_context_desc.backend_budget_mib caps it). */
+ * rc_context_desc.backend_budget_mib caps it). Capacities whose bytes could
+ * pass the address space (on 32-bit builds: from about 16M triangles) are
+ * RC_ERR_INVALID_ARGUMENT here and in rc_scene_create. */
 RC_API rc_status rc_scene_memory_requirements(const rc_context *ctx, const rc_scene_desc *desc,
                                               size_t *bytes);
 
@@ -361,7 +363,8 @@ RC_API rc_status rc_scene_destroy(rc_scene *scene);
 #define RC_MESH_COPY      1u  /* the arrays are copied into the arena; the built-in backend's
                                  commit renumbers the copy's vertices in the order its tree
                                  reads them (triangles, their order, corners and every result
-                                 unchanged), so a poor vertex order costs nothing */
+                                 unchanged), so a poor vertex order costs nothing (builds for
+                                 size, -Os, keep the caller's order) */
 
 typedef struct rc_mesh_desc {
     uint32_t struct_size;
