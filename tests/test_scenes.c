@@ -10,7 +10,6 @@
 
 #define DEG (3.14159265358979323846 / 180.0)
 
-static uint32_t backend_of(void **state) { return *(const uint32_t *)*state; }
 
 #define NEED_BACKEND(b)                       \
     do {                                      \
@@ -39,7 +38,7 @@ static void wall_mesh(float d, rcu_mesh *m)
  * normals facing the sensor and ids. */
 static void test_plane_at_distance(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *scene;
     rc_sensor *sensor;
@@ -103,7 +102,7 @@ static double box_exit(const double o[3], const double d[3], const float lo[3], 
  * analytic range; normals are the wall's axis, facing the sensor. */
 static void test_box_room_vlp16(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     const float lo[3] = {-5.0f, -4.0f, -1.0f}, hi[3] = {6.0f, 3.0f, 2.5f};
     rc_context *ctx;
     rc_scene *scene;
@@ -163,7 +162,7 @@ static void test_box_room_vlp16(void **state)
  * a brute-force search finds. */
 static void test_inside_sphere(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *scene;
     rc_sensor *sensor;
@@ -220,7 +219,7 @@ static void test_inside_sphere(void **state)
  * RC_INVALID_ID ids. */
 static void test_rep117_limits(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *scene;
     rc_sensor *sensor;
@@ -281,7 +280,7 @@ static void test_rep117_limits(void **state)
  * normals that stay perpendicular to the scaled faces. */
 static void test_instances(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
     rc_context *ctx;
     rc_scene *box, *world;
@@ -387,7 +386,7 @@ static void check_closed(uint32_t b, const rcu_mesh *m, const float origin[3])
 
 static void test_watertight(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rcu_mesh m;
     const float lo[3] = {-1.0f, -2.0f, -3.0f}, hi[3] = {4.0f, 5.0f, 6.0f};
     const float c0[3] = {0, 0, 0}, c1[3] = {0.3f, -0.7f, 0.1f}, c2[3] = {1.0f, 1.0f, 1.0f};
@@ -414,7 +413,7 @@ static void test_watertight(void **state)
 /* Thread count never changes a single bit of the results. */
 static void test_thread_independence(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     static const uint32_t counts[] = {1, 2, 3, 7};
     rcu_mesh m;
     rct_buffers ref, cur;
@@ -449,7 +448,7 @@ static void test_thread_independence(void **state)
 /* Only requested attributes are written; the others keep the caller's bytes. */
 static void test_only_requested_attributes(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *scene;
     rc_sensor *sensor;
@@ -482,7 +481,7 @@ static void test_only_requested_attributes(void **state)
 /* Coplanar duplicate triangles: the lower triangle index wins, every time. */
 static void test_coplanar_tie(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rcu_mesh a, both;
     rc_context *ctx;
     rc_scene *scene;
@@ -519,7 +518,7 @@ static void test_coplanar_tie(void **state)
 /* Depth camera facing a wall: range = d / cos(angle off the axis), both frames. */
 static void test_pinhole_wall(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *scene;
     rc_sensor *body, *optical;
@@ -573,7 +572,7 @@ static void test_pinhole_wall(void **state)
  * Ranges stay within a micrometre-scale error at every offset up to 1e6 m. */
 static void test_far_from_origin(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     static const double offsets[4] = {1e3, 1e4, 1e5, 1e6};
     const float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {12.0f, 8.0f, 3.0f};
     rcu_mesh m;
@@ -674,7 +673,7 @@ static void zero_area_scan(rc_context *ctx, rc_scene *scene, rc_sensor *sensor, 
 static void test_zero_area_updates(void **state)
 {
     enum { RAYS = 64 };
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     /* wall x = 10 (two triangles), then a, b, c at x = 5 with c = a + 2 (b - a) */
     static const float wall_and_segment[3 * 7] = {10.0f, -50.0f, -50.0f, 10.0f, 50.0f, -50.0f, 10.0f, 50.0f, 50.0f,
                                                   10.0f, -50.0f, 50.0f, 5.0f,  -1.0f, -0.5f, 5.0f,  0.0f,
@@ -759,7 +758,7 @@ static void test_zero_area_updates(void **state)
  * poses. */
 static void test_ranges_alone(void **state)
 {
-    uint32_t b = backend_of(state);
+    uint32_t b = rct_backend_of(state);
     const float lo[3] = {-3.0f, -2.0f, -0.2f}, hi[3] = {6.0f, 3.0f, 2.5f};
     const rc_pose poses[3] = {rct_pose_ypr(-2.7f, 0.5f, 1.0f, 2.8, 0.1, 0.0),
                               rct_pose_ypr(1.0f, 1.0f, 1.2f, -2.0, 0.2, 0.4), rct_pose(0.5f, -1.7f, 0.8f)};
@@ -821,21 +820,16 @@ static void test_ranges_alone(void **state)
     rc_context_destroy(ctx);
 }
 
-#define FOR_BACKENDS(f)                                            \
-    cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),        \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),    \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[2])
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        FOR_BACKENDS(test_plane_at_distance), FOR_BACKENDS(test_box_room_vlp16),
-        FOR_BACKENDS(test_inside_sphere),     FOR_BACKENDS(test_rep117_limits),
-        FOR_BACKENDS(test_instances),         FOR_BACKENDS(test_watertight),
-        FOR_BACKENDS(test_thread_independence), FOR_BACKENDS(test_only_requested_attributes),
-        FOR_BACKENDS(test_coplanar_tie),      FOR_BACKENDS(test_pinhole_wall),
-        FOR_BACKENDS(test_far_from_origin),   FOR_BACKENDS(test_zero_area_updates),
-        FOR_BACKENDS(test_ranges_alone),
+        RCT_FOR_BACKENDS(test_plane_at_distance), RCT_FOR_BACKENDS(test_box_room_vlp16),
+        RCT_FOR_BACKENDS(test_inside_sphere),     RCT_FOR_BACKENDS(test_rep117_limits),
+        RCT_FOR_BACKENDS(test_instances),         RCT_FOR_BACKENDS(test_watertight),
+        RCT_FOR_BACKENDS(test_thread_independence), RCT_FOR_BACKENDS(test_only_requested_attributes),
+        RCT_FOR_BACKENDS(test_coplanar_tie),      RCT_FOR_BACKENDS(test_pinhole_wall),
+        RCT_FOR_BACKENDS(test_far_from_origin),   RCT_FOR_BACKENDS(test_zero_area_updates),
+        RCT_FOR_BACKENDS(test_ranges_alone),
     };
     return cmocka_run_group_tests_name("scenes (every backend)", tests, NULL, NULL);
 }

@@ -40,7 +40,6 @@ static const known_issue known_issues[] = {
      "exact duplicates across geometries: not the smallest (geometry, triangle); twin instances are matched"},
 };
 
-static uint32_t backend_of(void **state) { return *(const uint32_t *)*state; }
 
 #define NEED_BACKEND(b)                     \
     do {                                    \
@@ -101,7 +100,7 @@ static void check_case(uint32_t backend, int kase, uint32_t threads, rcu_stab_co
 #define CASE_TEST(fn, kase)                                   \
     static void fn(void **state)                              \
     {                                                         \
-        uint32_t b = backend_of(state);                       \
+        uint32_t b = rct_backend_of(state);                       \
         NEED_BACKEND(b);                                      \
         check_case(b, kase, 2, NULL, NULL, "");               \
     }
@@ -117,7 +116,7 @@ CASE_TEST(test_far_origin, RCU_STAB_FAR_ORIGIN)
 /* Coplanar duplicates: the smallest key on every thread count. */
 static void test_coplanar(void **state)
 {
-    uint32_t b = backend_of(state), threads;
+    uint32_t b = rct_backend_of(state), threads;
     NEED_BACKEND(b);
     for (threads = 1; threads <= 3; threads++) check_case(b, RCU_STAB_COPLANAR, threads, NULL, NULL, "");
 }
@@ -208,18 +207,13 @@ static void test_reference_self_check(void **state)
     rcu_mesh_free(&box);
 }
 
-#define FOR_BACKENDS(f)                                            \
-    cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),        \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),    \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[2])
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_reference_self_check),
-        FOR_BACKENDS(test_grazing),        FOR_BACKENDS(test_degenerate),     FOR_BACKENDS(test_on_surface),
-        FOR_BACKENDS(test_axis_parallel),  FOR_BACKENDS(test_long_short),     FOR_BACKENDS(test_instance_scale),
-        FOR_BACKENDS(test_far_origin),     FOR_BACKENDS(test_coplanar),       cmocka_unit_test(test_embree_not_robust),
+        RCT_FOR_BACKENDS(test_grazing),        RCT_FOR_BACKENDS(test_degenerate),     RCT_FOR_BACKENDS(test_on_surface),
+        RCT_FOR_BACKENDS(test_axis_parallel),  RCT_FOR_BACKENDS(test_long_short),     RCT_FOR_BACKENDS(test_instance_scale),
+        RCT_FOR_BACKENDS(test_far_origin),     RCT_FOR_BACKENDS(test_coplanar),       cmocka_unit_test(test_embree_not_robust),
     };
     return cmocka_run_group_tests_name("stability (every backend against the float64 reference)", tests, NULL, NULL);
 }

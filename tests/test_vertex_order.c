@@ -10,8 +10,6 @@
 #include "bvh/mesh.h" /* RC__ORDER_COPIES */
 #include "rc_test.h"
 
-static uint32_t backend_of(void **state) { return *(const uint32_t *)*state; }
-
 /* Deterministic shuffle (a 64-bit LCG), so a failure repeats. */
 static uint32_t next_random(uint64_t *s, uint32_t bound)
 {
@@ -55,18 +53,12 @@ static void shuffled_sphere(rcu_mesh *out)
     rcu_mesh_free(&m);
 }
 
-static void simulate_all(rc_context *ctx, const rc_scene *scene, const rc_sensor *sensor, const rc_pose *poses,
-                         uint32_t n, rct_buffers *buf)
-{
-    RCT_OK(ctx, rc_simulate(ctx, scene, sensor, poses, n, &buf->res));
-}
-
 /* The same mesh referenced and copied gives every attribute byte for byte
  * the same (the copy renumbered on the built-in backend, as it is on its
  * own there), and the sphere's rays all hit. */
 static void test_copy_gives_the_same_results(void **state)
 {
-    const uint32_t b = backend_of(state);
+    const uint32_t b = rct_backend_of(state);
     rc_context *ctx;
     rc_scene *ref, *copy;
     rc_sensor *sensor;
@@ -88,8 +80,8 @@ static void test_copy_gives_the_same_results(void **state)
     RCT_OK(ctx, rc_sensor_get_info(sensor, &info));
     rct_buffers_alloc(&a, 4u * (uint64_t)info.rays_per_scan, RC_ATTR_ALL);
     rct_buffers_alloc(&c, 4u * (uint64_t)info.rays_per_scan, RC_ATTR_ALL);
-    simulate_all(ctx, ref, sensor, poses, 4, &a);
-    simulate_all(ctx, copy, sensor, poses, 4, &c);
+    RCT_OK(ctx, rc_simulate(ctx, ref, sensor, poses, 4, &a.res));
+    RCT_OK(ctx, rc_simulate(ctx, copy, sensor, poses, 4, &c.res));
     rct_assert_same_results(&a, &c);
     for (k = 0; k < a.n; ++k) {
         assert_int_equal(a.res.hits[k], 1);
@@ -174,15 +166,10 @@ static void test_copy_is_renumbered_in_leaf_order(void **state)
     rcu_mesh_free(&m);
 }
 
-#define EVERY_BACKEND(f)                                       \
-    cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),    \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[1]), \
-        cmocka_unit_test_prestate(f, (void *)&rct_backends[2])
-
 int main(void)
 {
     const struct CMUnitTest tests[] = {
-        EVERY_BACKEND(test_copy_gives_the_same_results),
+        RCT_FOR_BACKENDS(test_copy_gives_the_same_results),
         cmocka_unit_test(test_copy_is_renumbered_in_leaf_order),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

@@ -22,6 +22,13 @@
 
 /* Every backend id the parameterised suites run over (BVH, EMBREE, VULKAN). */
 extern const uint32_t rct_backends[3];
+/* A test once per backend (its state points into rct_backends), and the
+ * backend a run got. */
+#define RCT_FOR_BACKENDS(f)                                         \
+    cmocka_unit_test_prestate(f, (void *)&rct_backends[0]),         \
+        cmocka_unit_test_prestate(f, (void *)&rct_backends[1]),     \
+        cmocka_unit_test_prestate(f, (void *)&rct_backends[2])
+#define rct_backend_of(state) (*(const uint32_t *)*(state))
 
 /* 1 when the backend can make a context here; prints a skip message and
  * returns 0 otherwise (the caller then calls skip()). */
