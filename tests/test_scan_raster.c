@@ -17,9 +17,12 @@
  * that only shows they change nothing), under turned poses and a mounting,
  * with range limits that cut triangles off, with and without the mesh's
  * tree, and with every triangle twice (ties); a long lens on a wall of
- * tiny triangles whose corners lie on its pixels' rays; and the placement's
- * atan2 against libm's. Then through rc_simulate (a VLP-16, the cylindrical
- * panorama and the first camera): every attribute of a call that takes the projected scan equals,
+ * tiny triangles whose corners lie on its pixels' rays; scenes of two to
+ * four meshes (each mesh's tree searched in turn; copies of meshes and twins
+ * within one, so hits tie across meshes and within one); and the
+ * placement's atan2 against libm's. Then through rc_simulate (a VLP-16, the
+ * cylindrical panorama and the first camera) on a room as one mesh and as
+ * three: every attribute of a call that takes the projected scan equals,
  * byte for byte, a context without arena room for its scratch (the packets),
  * on 1 and 3 threads. */
 #include <math.h>
@@ -146,40 +149,45 @@ static uint32_t band_rows;
 /* The projected scan of rows [row0, row0 + rows) of g into hits, found and
  * td (the whole scan's arrays), its hits in runs of 37 rays (the last one
  * shorter). */
+#define MAX_MESHES 4u
+
 static void scan_band(const rc_scene *scene, const rc_sensor *s, const rc__raster_grid *g, const rc__xformf *world,
                       uint32_t row0, uint32_t rows, rc__hit *hits, int *found, double *td)
 {
-    const rc__mesh *mesh = &scene->geoms[0].mesh;
-    const uint32_t base = row0 * g->cols, n_rays = rows * g->cols;
+    const uint32_t base = row0 * g->cols, n_rays = rows * g->cols, count = scene->geom_count;
     const float *dirs = s->directions + (size_t)base * 3u;
     void *scratch = malloc(rc__raster_scratch_bytes(n_rays));
+    const rc__mesh *meshes[MAX_MESHES];
+    rc__mesh bare[MAX_MESHES];
     rc__raster_grid band;
     uint32_t i;
     assert_non_null(scratch);
-    rc__raster_band(g, row0, rows, &band);
-    if (flat) {
-        /* without the tree (a mesh no built-in commit made): every
-         * triangle placed; the tree back for the search below */
-        rc__mesh bare = *mesh;
-        bare.wide = NULL;
-        bare.wide_count = 0;
-        rc__raster_scan(&bare, &band, world, dirs, s->range_max, scratch);
-    } else {
-        rc__raster_scan(mesh, &band, world, dirs, s->range_max, scratch);
+    assert_true(count >= 1u && count <= MAX_MESHES);
+    for (i = 0; i < count; ++i) {
+        /* flat: without the trees (meshes no built-in commit made), every
+         * triangle placed; the trees stay for the search below */
+        bare[i] = scene->geoms[i].mesh;
+        if (flat) {
+            bare[i].wide = NULL;
+            bare[i].wide_count = 0;
+        }
+        meshes[i] = &bare[i];
     }
+    rc__raster_band(g, row0, rows, &band);
+    rc__raster_scan(meshes, count, &band, world, dirs, s->range_max, scratch);
     for (i = 0; i < n_rays; i += 37u) {
         const uint32_t n = n_rays - i < 37u ? n_rays - i : 37u;
-        rc__raster_hits(mesh, 0u, n_rays, world, dirs, scratch, i, n, hits + base + i, found + base + i,
+        rc__raster_hits(meshes, count, n_rays, world, dirs, scratch, i, n, hits + base + i, found + base + i,
                         td + base + i);
     }
     free(scratch);
 }
 
-/* The projected scan of one pose against rc__mesh_intersect ray by ray;
- * returns the rays that hit. */
+/* The projected scan of one pose against rc__mesh_intersect ray by ray,
+ * over each of the scene's meshes in turn (as the packets go); returns the
+ * rays that hit. */
 static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_pose *pose)
 {
-    const rc__mesh *mesh = &scene->geoms[0].mesh;
     rc__raster_grid g;
     rc__xformf world;
     const uint32_t rays = s->rays;
@@ -197,18 +205,20 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
     for (i = 0; i < rays; ++i) {
         rc__ray ray;
         rc__hit want;
-        int want_found;
+        int want_found = 0;
+        uint32_t m;
         rc__rays_prepare_turned(world.r, world.t, s->directions, &i, 1u, &ray);
         want.t = s->range_max;
         want.prim = want.geom = want.inst = want.slot = RC_INVALID_ID;
-        want_found = rc__mesh_intersect(mesh, &ray, 0u, RC_INVALID_ID, &want);
+        for (m = 0; m < scene->geom_count; ++m)
+            want_found |= rc__mesh_intersect(&scene->geoms[m].mesh, &ray, m, RC_INVALID_ID, &want);
         if (want_found != found[i]) fail_msg("ray %u: found %d, the tree %d", i, found[i], want_found);
         if (!want_found) continue;
         ++hit_count;
-        if (memcmp(&want.t, &hits[i].t, sizeof want.t) != 0 || want.prim != hits[i].prim)
-            fail_msg("ray %u: t %.9g on %u, the tree %.9g on %u", i, (double)hits[i].t, hits[i].prim, (double)want.t,
-                     want.prim);
-        assert_int_equal(hits[i].geom, 0u);
+        if (memcmp(&want.t, &hits[i].t, sizeof want.t) != 0 || want.prim != hits[i].prim || want.geom != hits[i].geom)
+            fail_msg("ray %u: t %.9g on %u of mesh %u, the tree %.9g on %u of mesh %u", i, (double)hits[i].t,
+                     hits[i].prim, hits[i].geom, (double)want.t, want.prim, want.geom);
+        assert_int_equal(hits[i].slot, want.slot);
         assert_int_equal(hits[i].inst, RC_INVALID_ID);
         {
             /* the distance refined as the writer would refine it */
@@ -223,19 +233,20 @@ static uint32_t check_pose(const rc_scene *scene, const rc_sensor *s, const rc_p
     return hit_count;
 }
 
-/* Every grid at every pose; at least min_hits of all their rays hit. */
-static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_count, float rmin, float rmax,
-                       double min_hits, int unfold)
+/* Every grid at every pose on a scene of the meshes ms[0 .. count) (one:
+ * rct_scene_mesh's scene); at least min_hits of all their rays hit. */
+static void check_meshes(const rcu_mesh *const *ms, uint32_t count, const rc_pose *poses, uint32_t pose_count,
+                         float rmin, float rmax, double min_hits, int unfold)
 {
     rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
-    rc_scene *scene = rct_scene_mesh(ctx, m, RC_MESH_REFERENCE);
-    rc__mesh *mesh = &scene->geoms[0].mesh;
+    rc_scene *scene = count == 1u ? rct_scene_mesh(ctx, ms[0], RC_MESH_REFERENCE) : rct_scene_meshes(ctx, ms, count);
     const rc_pose mount = rct_pose_ypr(0.1f, -0.05f, 0.2f, 0.3, 0.2, -0.1);
     uint64_t rays = 0, hit = 0;
     uint32_t k, p;
     flat = unfold == 2;
-    if (unfold) {
+    for (k = 0; unfold && k < count; ++k) {
         /* the tests' own triples: zero-area triangles whole, checked */
+        rc__mesh *mesh = &scene->geoms[k].mesh;
         assert_true(mesh->flats_folded);
         rc__mesh_unfold_flats(mesh, (uint32_t *)(uintptr_t)mesh->leaf_tris);
         mesh->flats_folded = 0;
@@ -260,6 +271,12 @@ static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_co
     if (hit < min_hits * (double)rays) fail_msg("%llu of %llu rays hit", (unsigned long long)hit, (unsigned long long)rays);
     rc_scene_destroy(scene);
     rc_context_destroy(ctx);
+}
+
+static void check_mesh(const rcu_mesh *m, const rc_pose *poses, uint32_t pose_count, float rmin, float rmax,
+                       double min_hits, int unfold)
+{
+    check_meshes(&m, 1u, poses, pose_count, rmin, rmax, min_hits, unfold);
 }
 
 /* check_mesh with the mesh's tree (its zero-area triangles unfolded when
@@ -540,6 +557,47 @@ static void test_coincident_copies(void **state)
     rcu_mesh_free(&m);
 }
 
+/* A scene of four meshes: a room, a ball in it with every triangle twice,
+ * the ball again and the room again (each its own copy of the values).
+ * Every hit on the room ties with its copy three meshes later, and every
+ * hit on the ball with its twin in the same mesh and its copy in the next:
+ * the smaller geometry id wins across meshes whichever is placed first, and
+ * within the second mesh (whose triangles are numbered after the room's)
+ * the smaller prim id; the ball is met before the room behind it, and the
+ * room copy's walls after the ball. With the trees and without. */
+static void test_meshes(void **state)
+{
+    const float lo[3] = {-4.0f, -3.0f, -1.0f}, hi[3] = {5.0f, 4.0f, 2.5f};
+    const float at[3] = {1.5f, 0.5f, 0.8f};
+    const rc_pose poses[] = {rct_pose(0.0f, 0.0f, 0.3f), rct_pose_ypr(-2.5f, -1.0f, 1.2f, 0.3, 0.2, -0.1),
+                             rct_pose_ypr(3.9f, 3.1f, 2.0f, -2.6, 0.4, 0.3)};
+    rcu_mesh room, twins, ball, room2;
+    const rcu_mesh *ms[4];
+    (void)state;
+    assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &room2), 0);
+    assert_int_equal(rcu_mesh_uv_sphere(0.9f, 16u, 9u, &twins), 0);
+    assert_int_equal(rcu_mesh_uv_sphere(0.9f, 16u, 9u, &ball), 0);
+    assert_int_equal(rcu_mesh_append(&twins, &ball), 0);
+    rcu_mesh_transform(&twins, 0.0f, at);
+    rcu_mesh_transform(&ball, 0.0f, at);
+    ms[0] = &room;
+    ms[1] = &twins;
+    ms[2] = &ball;
+    ms[3] = &room2;
+    check_meshes(ms, 4u, poses, 3u, 0.0f, 50.0f, 0.45, 0);
+    check_meshes(ms, 4u, poses, 3u, 0.0f, 50.0f, 0.45, 2);
+    flat = 0;
+    /* the ball alone before the room: the nearer mesh placed first */
+    ms[0] = &ball;
+    ms[1] = &room;
+    check_meshes(ms, 2u, poses, 3u, 0.5f, 50.0f, 0.45, 0);
+    rcu_mesh_free(&room);
+    rcu_mesh_free(&room2);
+    rcu_mesh_free(&twins);
+    rcu_mesh_free(&ball);
+}
+
 /* enough for 3 threads to take a pose each (fewer poses than 4 a thread
  * split scans into slices, which take the packets) */
 #define POSES 12u
@@ -572,12 +630,14 @@ static rc_sensor *fill_arena(rc_context *ctx, size_t left)
 /* Every attribute of calls with ctx (room for the projected scan's scratch)
  * and tight (none: the packets), byte for byte: a VLP-16 (kind 0), the
  * first cylindrical grid (1) or the first camera, 0.8 to 4 m (2). */
-static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m, uint32_t threads, int kind)
+static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *const *ms, uint32_t count,
+                          uint32_t threads, int kind)
 {
     const uint32_t attrs = RC_ATTR_HITS | RC_ATTR_RANGES | RC_ATTR_POINTS | RC_ATTR_NORMALS | RC_ATTR_PRIM_IDS |
                            RC_ATTR_GEOM_IDS | RC_ATTR_INST_IDS;
     rc_pose poses[POSES];
-    rc_scene *sa = rct_scene_mesh(ctx, m, RC_MESH_REFERENCE), *sb = rct_scene_mesh(tight, m, RC_MESH_REFERENCE);
+    rc_scene *sa = count == 1u ? rct_scene_mesh(ctx, ms[0], RC_MESH_REFERENCE) : rct_scene_meshes(ctx, ms, count);
+    rc_scene *sb = count == 1u ? rct_scene_mesh(tight, ms[0], RC_MESH_REFERENCE) : rct_scene_meshes(tight, ms, count);
     rc_sensor *a = NULL, *b = NULL, *filler;
     rc_memory_stats before = rc_memory_stats_default(), after = rc_memory_stats_default();
     rct_buffers ba, bb;
@@ -654,12 +714,13 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *m,
 static void test_simulate(void **state)
 {
     const float lo[3] = {-3.0f, -2.0f, -0.2f}, hi[3] = {4.0f, 3.0f, 2.5f};
-    rcu_mesh room, sphere;
+    rcu_mesh room, sphere, open_room, face;
     uint32_t threads;
     (void)state;
-    assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
     /* the room's floor, walls and ceiling, and a ball in it; the room's
      * corner at (-3, -2) is cut open by the ball's range of sight */
+    assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &open_room), 0);
     assert_int_equal(rcu_mesh_uv_sphere(0.8f, 24u, 12u, &sphere), 0);
     {
         const float at[3] = {1.5f, 0.5f, 1.0f};
@@ -669,16 +730,31 @@ static void test_simulate(void **state)
     /* an opening: the box's first two triangles (a face) dropped */
     memmove(room.indices, room.indices + 6u, (room.triangle_count - 2u) * 3u * sizeof(uint32_t));
     room.triangle_count -= 2u;
+    memmove(open_room.indices, open_room.indices + 6u, (open_room.triangle_count - 2u) * 3u * sizeof(uint32_t));
+    open_room.triangle_count -= 2u;
+    /* and as a scene of three meshes: the open room, the ball, and the
+     * room's next face again (its copy's hits tie with the room's and lose) */
+    assert_int_equal(rcu_mesh_box(lo, hi, &face), 0);
+    memmove(face.indices, face.indices + 6u, 6u * sizeof(uint32_t));
+    face.triangle_count = 2u;
     for (threads = 1; threads <= 3; threads += 2) {
-        int kind;
-        for (kind = 0; kind < 3; ++kind) {
-            rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
-            rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
-            compare_calls(ctx, tight, &room, threads, kind);
-            rc_context_destroy(ctx);
-            rc_context_destroy(tight);
-        }
+        int kind, scene;
+        for (scene = 0; scene < 2; ++scene)
+            for (kind = 0; kind < 3; ++kind) {
+                const rcu_mesh *split[3] = {&open_room, &sphere, &face};
+                const rcu_mesh *whole = &room;
+                rc_context *ctx = rct_context(RC_BACKEND_BVH, threads, 0);
+                rc_context *tight = rct_context(RC_BACKEND_BVH, threads, 0);
+                if (scene)
+                    compare_calls(ctx, tight, split, 3u, threads, kind);
+                else
+                    compare_calls(ctx, tight, &whole, 1u, threads, kind);
+                rc_context_destroy(ctx);
+                rc_context_destroy(tight);
+            }
     }
+    rcu_mesh_free(&face);
+    rcu_mesh_free(&open_room);
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&room);
 }
@@ -692,6 +768,7 @@ int main(void)
         cmocka_unit_test(test_rare_cases),
         cmocka_unit_test(test_unfolded_flats),
         cmocka_unit_test(test_coincident_copies),
+        cmocka_unit_test(test_meshes),
         cmocka_unit_test(test_edges_on_rows),
         cmocka_unit_test(test_corners_on_pixels),
         cmocka_unit_test(test_simulate),

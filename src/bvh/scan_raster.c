@@ -20,9 +20,10 @@
 
 /* Per-ray constants of the watertight test, one array each (the shared
  * origin needs no copy): the shear and the axis order, kx | ky << 2 | kz << 4;
- * and each ray's nearest hit so far, its t and leaf-order slot (bs
- * RC_INVALID_ID: none yet), kept in arrays so that eight rays take their
- * offers at once in lanes. */
+ * and each ray's nearest hit so far, its t and its triangle's id (bs
+ * RC_INVALID_ID: none yet; an id is the triangle's leaf-order slot in its
+ * mesh plus the slots of the meshes before it, raster_tri.id), kept in
+ * arrays so that eight rays take their offers at once in lanes. */
 typedef struct raster_rays {
     float *sx, *sy, *sz;
     float *bt;
@@ -134,7 +135,7 @@ static RC__FORCE_INLINE int shared_origin_test(const float *ra, const float *rb,
 typedef struct raster_tri {
     const float *v[3];
     float rel[3][3];
-    uint32_t slot;
+    uint32_t id; /* the scan's number for it: raster_scan.base + its leaf slot */
 } raster_tri;
 
 /* A pinhole grid's camera in the map frame: a point p (relative to the
@@ -153,7 +154,10 @@ typedef struct raster_cam {
 
 /* What every test of one scan shares. */
 typedef struct raster_scan {
-    const rc__mesh *mesh;
+    const rc__mesh *const *meshes; /* the scene's, in geometry order */
+    uint32_t mesh_count;
+    const rc__mesh *mesh;          /* the one being placed, meshes[g] */
+    uint32_t base;                 /* its first id: the slots of meshes[0 .. g) */
     const rc__raster_grid *g;
     raster_rays rr;
     const float *r, *org, *dirs;
@@ -172,18 +176,20 @@ RC__COLD int full_test(const raster_tri *tri, const raster_scan *sc, uint32_t ra
 }
 
 /* A hit at t on ray i offered: kept when nearer than the ray's best, or as
- * near with a smaller prim id (rc__hit_offer_slot's rule for one mesh and
- * no instance; a ray with no hit yet takes a hit at tmax itself). */
+ * near with a smaller key (rc__hit_offer_slot's rule without instances: the
+ * smaller geometry id, then the smaller prim id). The meshes are placed in
+ * geometry order, so a best from an earlier mesh keeps a tie. A ray with no
+ * hit yet takes a hit at tmax itself. */
 static RC__FORCE_INLINE void offer(const raster_tri *tri, const raster_scan *sc, uint32_t i, float t)
 {
     const uint32_t best = sc->rr.bs[i];
     if (t > sc->rr.bt[i]) return;
     if (t == sc->rr.bt[i] && best != RC_INVALID_ID) {
         const uint32_t *refs = sc->mesh->bvh.refs;
-        if (!(refs[tri->slot] < refs[best])) return;
+        if (best < sc->base || !(refs[tri->id - sc->base] < refs[best - sc->base])) return;
     }
     sc->rr.bt[i] = t;
-    sc->rr.bs[i] = tri->slot;
+    sc->rr.bs[i] = tri->id;
 }
 
 /* The triangle's test of ray i, and its offer. */
@@ -274,7 +280,7 @@ static RC__FORCE_INLINE unsigned test8(const raster_tri *tri, const raster_scan 
         nearer = hits & (tt < bt);
         same = hits & (tt == bt);
         bt = select8(nearer, tt, bt);
-        bs = select8i(nearer, splat8i((int32_t)tri->slot), bs);
+        bs = select8i(nearer, splat8i((int32_t)tri->id), bs);
         memcpy(sc->rr.bt + i, &bt, sizeof bt);
         memcpy(sc->rr.bs + i, &bs, sizeof bs);
         memcpy(tt_out, &tt, sizeof tt);
@@ -731,7 +737,7 @@ static RC__FORCE_INLINE void raster_slots(const raster_scan *sc, uint32_t first,
             tri->v[c] = verts + (size_t)ix[c] * stride;
             for (k = 0; k < 3; ++k) tri->rel[c][k] = tri->v[c][k] - sc->org[k];
         }
-        tri->slot = s;
+        tri->id = sc->base + s;
         /* zero area: never hit (the tests skip what a commit folded) */
         if (!mesh->flats_folded && rc__tri_zero_area(tri->v[0], tri->v[1], tri->v[2])) continue;
         if (sc->g->pinhole) {
@@ -791,28 +797,36 @@ static RC__FORCE_INLINE void raster_tree(const raster_scan *sc)
     }
 }
 
-/* The scan's rays, then the mesh's triangles through them: by its tree
- * where it has one (the built-in backend's commit builds it), else all. */
-static RC__FORCE_INLINE void raster_all(const raster_scan *sc)
+/* The scan's rays, then each mesh's triangles through them, in geometry
+ * order: by its tree where it has one (the built-in backend's commit builds
+ * it), else all. */
+static RC__FORCE_INLINE void raster_all(raster_scan *sc)
 {
-    const rc__mesh *mesh = sc->mesh;
     const uint32_t rays = sc->g->rows * sc->g->cols;
+    uint32_t g, base = 0;
 #if defined(RC__RASTER_LANES)
     rays_fill(rays_fill8(rays, sc->r, sc->dirs, &sc->rr), rays, sc->r, sc->org, sc->dirs, &sc->rr);
 #else
     rays_fill(0u, rays, sc->r, sc->org, sc->dirs, &sc->rr);
 #endif
-    if (mesh->wide && mesh->wide_count)
-        raster_tree(sc);
-    else
-        raster_slots(sc, 0u, mesh->bvh.item_count);
+    for (g = 0; g < sc->mesh_count; ++g) {
+        const rc__mesh *mesh = sc->meshes[g];
+        sc->mesh = mesh;
+        sc->base = base;
+        base += mesh->bvh.item_count;
+        if (mesh->bvh.item_count == 0) continue;
+        if (mesh->wide && mesh->wide_count)
+            raster_tree(sc);
+        else
+            raster_slots(sc, 0u, mesh->bvh.item_count);
+    }
 }
 
 #if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__RASTER_LANES)
 /* The same in AVX2's 256-bit lanes (no fused multiply-add: the same bits). */
-static __attribute__((target("avx2"), noinline)) void raster_all_avx2(const raster_scan *sc) { raster_all(sc); }
+static __attribute__((target("avx2"), noinline)) void raster_all_avx2(raster_scan *sc) { raster_all(sc); }
 #endif
-static void raster_all_base(const raster_scan *sc) { raster_all(sc); }
+static void raster_all_base(raster_scan *sc) { raster_all(sc); }
 
 /* The plane of the triangle with corners v as rc__scene_hit_distance_d
  * computes it (a mesh of the scene's own: no instance transform), from the
@@ -866,8 +880,8 @@ static void camera_setup(const rc__raster_grid *g, const float r[9], raster_cam 
     }
 }
 
-void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__xformf *world, const float *dirs,
-                     float tmax, void *scratch)
+void rc__raster_scan(const rc__mesh *const *meshes, uint32_t mesh_count, const rc__raster_grid *g,
+                     const rc__xformf *world, const float *dirs, float tmax, void *scratch)
 {
     const uint32_t rays = g->rows * g->cols;
     rc__raster_grid grid = *g;
@@ -875,7 +889,10 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
     uint32_t i;
     grid.phi_inv = g->phi_inc != 0.0 ? 1.0 / g->phi_inc : 0.0;
     grid.theta_inv = g->theta_inc != 0.0 ? 1.0 / g->theta_inc : 0.0;
-    sc.mesh = mesh;
+    sc.meshes = meshes;
+    sc.mesh_count = mesh_count;
+    sc.mesh = NULL;
+    sc.base = 0;
     sc.g = &grid;
     scratch_split(scratch, rays, &sc.rr);
     sc.r = world->r;
@@ -906,41 +923,59 @@ void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__x
  * any (the division a ray was half the time of the scalar loop, its latency
  * in the way of every result). Each lane repeats the scalar refinement's
  * operations in their order. */
-static RC__FORCE_INLINE void hits_run(const rc__mesh *mesh, uint32_t geom, const rc__xformf *world, const float *dirs,
-                                      const raster_rays *rr, uint32_t first, uint32_t n, rc__hit *hits, int *found,
-                                      double *td)
+/* Which mesh a triangle id (raster_tri.id) belongs to: *g and the id range
+ * [*lo, *hi) of meshes[*g], moved only when id lies outside it (a run's
+ * neighbouring rays mostly meet one mesh). */
+static RC__FORCE_INLINE void mesh_of_id(const rc__mesh *const *meshes, uint32_t mesh_count, uint32_t id, uint32_t *g,
+                                        uint32_t *lo, uint32_t *hi)
+{
+    if (id >= *lo && id < *hi) return;
+    *g = 0;
+    *lo = 0;
+    *hi = meshes[0]->bvh.item_count;
+    while (id >= *hi && *g + 1u < mesh_count) {
+        *lo = *hi;
+        *hi += meshes[++*g]->bvh.item_count;
+    }
+}
+
+static RC__FORCE_INLINE void hits_run(const rc__mesh *const *meshes, uint32_t mesh_count, const rc__xformf *world,
+                                      const float *dirs, const raster_rays *rr, uint32_t first, uint32_t n,
+                                      rc__hit *hits, int *found, double *td)
 {
     const double *r = world->rd;
-    const uint32_t *refs = mesh->bvh.refs, *bs = rr->bs + first;
+    const uint32_t *bs = rr->bs + first;
     const float *bt = rr->bt + first, *p = dirs + (size_t)first * 3u;
-    uint32_t i, last = RC_INVALID_ID;
+    uint32_t i, last = RC_INVALID_ID, g = 0, lo = 0, hi = 0;
     double nv[3] = {0.0, 0.0, 0.0}, w = 0.0;
     for (i = 0; i < n; ++i) {
-        const uint32_t slot = bs[i];
+        const uint32_t id = bs[i];
         hits[i].t = bt[i];
         hits[i].geom = hits[i].prim = hits[i].inst = hits[i].slot = RC_INVALID_ID;
-        found[i] = slot != RC_INVALID_ID;
-        if (slot == RC_INVALID_ID) continue;
-        hits[i].prim = refs[slot];
-        hits[i].geom = geom;
-        hits[i].slot = slot;
+        found[i] = id != RC_INVALID_ID;
+        if (id == RC_INVALID_ID) continue;
+        mesh_of_id(meshes, mesh_count, id, &g, &lo, &hi);
+        hits[i].prim = meshes[g]->bvh.refs[id - lo];
+        hits[i].geom = g;
+        hits[i].slot = id - lo;
     }
     for (i = 0; i < n;) {
-        const uint32_t slot = bs[i];
-        if (slot == RC_INVALID_ID) {
+        const uint32_t id = bs[i];
+        if (id == RC_INVALID_ID) {
             ++i;
             continue;
         }
-        if (slot != last) {
-            const uint32_t *ix = mesh->leaf_tris + (size_t)slot * 3u;
+        if (id != last) {
+            const rc__mesh *mesh = meshes[hits[i].geom];
+            const uint32_t *ix = mesh->leaf_tris + (size_t)hits[i].slot * 3u;
             const float *v[3];
             int c;
             for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)ix[c] * mesh->stride;
             plane(v, world->td, nv, &w);
-            last = slot;
+            last = id;
         }
 #if defined(RC__CONE_LANES)
-        if (i + 4u <= n && bs[i + 1u] == slot && bs[i + 2u] == slot && bs[i + 3u] == slot) {
+        if (i + 4u <= n && bs[i + 1u] == id && bs[i + 2u] == id && bs[i + 3u] == id) {
             const float *d = p + (size_t)i * 3u;
             const rc__v4d x = {d[0], d[3], d[6], d[9]}, y = {d[1], d[4], d[7], d[10]}, z = {d[2], d[5], d[8], d[11]};
             const rc__v4d dx = r[0] * x + r[1] * y + r[2] * z;
@@ -969,27 +1004,29 @@ static RC__FORCE_INLINE void hits_run(const rc__mesh *mesh, uint32_t geom, const
 }
 
 #if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__CONE_LANES)
-static __attribute__((target("avx2"), noinline)) void hits_run_avx2(const rc__mesh *mesh, uint32_t geom,
-                                                                  const rc__xformf *world, const float *dirs,
-                                                                  const raster_rays *rr, uint32_t first, uint32_t n,
-                                                                  rc__hit *hits, int *found, double *td)
+static __attribute__((target("avx2"), noinline)) void hits_run_avx2(const rc__mesh *const *meshes,
+                                                                  uint32_t mesh_count, const rc__xformf *world,
+                                                                  const float *dirs, const raster_rays *rr,
+                                                                  uint32_t first, uint32_t n, rc__hit *hits,
+                                                                  int *found, double *td)
 {
-    hits_run(mesh, geom, world, dirs, rr, first, n, hits, found, td);
+    hits_run(meshes, mesh_count, world, dirs, rr, first, n, hits, found, td);
 }
 #endif
 
-void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
-                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td)
+void rc__raster_hits(const rc__mesh *const *meshes, uint32_t mesh_count, uint32_t rays, const rc__xformf *world,
+                     const float *dirs, void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found,
+                     double *td)
 {
     raster_rays rr;
     scratch_split(scratch, rays, &rr);
 #if defined(RC__LEAF4_PAIR_AVX2) && defined(RC__CONE_LANES)
     if (rc__leaf4_have_avx2()) {
-        hits_run_avx2(mesh, geom, world, dirs, &rr, first, n, hits, found, td);
+        hits_run_avx2(meshes, mesh_count, world, dirs, &rr, first, n, hits, found, td);
         return;
     }
 #endif
-    hits_run(mesh, geom, world, dirs, &rr, first, n, hits, found, td);
+    hits_run(meshes, mesh_count, world, dirs, &rr, first, n, hits, found, td);
 }
 #else
 typedef int rc__scan_raster_left_out; /* ISO C: no empty translation unit */

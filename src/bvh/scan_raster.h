@@ -1,5 +1,6 @@
 /* Projected scans: a spherical, cylindrical or pinhole scan of a small mesh
- * traced triangle by triangle instead of ray by ray. A spinning sensor's
+ * (or a few, a scene's geometries) traced triangle by triangle instead of
+ * ray by ray. A spinning sensor's
  * rays are found from angles: each triangle's bounding sphere, seen from the
  * sensor, covers a cone, and the rows and columns of the scan's grid that
  * can fall in that cone are found from the grid's angles. A camera's are
@@ -66,22 +67,28 @@ int rc__raster_grid_ok(const rc__raster_grid *g);
  * multiples). */
 size_t rc__raster_scratch_bytes(uint32_t rays);
 
-/* Traces one scan on mesh (no instance): every ray i = row * cols + column
- * of the grid, its nearest hit kept in scratch (rc__raster_scratch_bytes(rays))
- * for rc__raster_hits. world turns the sensor's unit directions dirs (scan
- * order) into the map frame as the packets' rc__rays_prepare_turned does. */
-void rc__raster_scan(const rc__mesh *mesh, const rc__raster_grid *g, const rc__xformf *world, const float *dirs,
-                     float tmax, void *scratch);
+/* Traces one scan on meshes[0 .. mesh_count), mesh_count >= 1, the
+ * geometries 0, 1, ... of a scene without instances (a mesh without
+ * triangles is passed over): every ray i = row * cols + column of the grid,
+ * its nearest hit over all of them kept in scratch
+ * (rc__raster_scratch_bytes(rays)) for rc__raster_hits, as near ties go in
+ * rc__hit_offer_slot (the smaller geometry id, then prim id). The meshes'
+ * triangles together number less than RC_INVALID_ID. world turns the
+ * sensor's unit directions dirs (scan order) into the map frame as the
+ * packets' rc__rays_prepare_turned does. */
+void rc__raster_scan(const rc__mesh *const *meshes, uint32_t mesh_count, const rc__raster_grid *g,
+                     const rc__xformf *world, const float *dirs, float tmax, void *scratch);
 
 /* Rays [first, first + n) of the scan of `rays` rays that rc__raster_scan
- * left in scratch (the same mesh, world and dirs), as the writer takes them:
- * hits[i] and found[i] for ray first + i as rc__mesh_intersect gives them
- * from hits reset to (tmax, no id), with geometry id geom and prims
- * settled, and for each hit td[i], its distance refined in double as
- * rc__scene_hit_distance_d gives it. A run at a time, so that the writer
- * reads them from the cache. */
-void rc__raster_hits(const rc__mesh *mesh, uint32_t geom, uint32_t rays, const rc__xformf *world, const float *dirs,
-                     void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found, double *td);
+ * left in scratch (the same meshes, world and dirs), as the writer takes
+ * them: hits[i] and found[i] for ray first + i as rc__mesh_intersect over
+ * meshes[0], meshes[1], ... (geometry ids 0, 1, ...) gives them from hits
+ * reset to (tmax, no id), prims settled, and for each hit td[i], its
+ * distance refined in double as rc__scene_hit_distance_d gives it. A run at
+ * a time, so that the writer reads them from the cache. */
+void rc__raster_hits(const rc__mesh *const *meshes, uint32_t mesh_count, uint32_t rays, const rc__xformf *world,
+                     const float *dirs, void *scratch, uint32_t first, uint32_t n, rc__hit *hits, int *found,
+                     double *td);
 
 #endif /* RC__PROJECTED_SCANS */
 

@@ -23,7 +23,6 @@ int main(int argc, char **argv)
     const float lo[3] = {-0.5f, -0.5f, -0.5f}, hi[3] = {0.5f, 0.5f, 0.5f};
     rc_context_desc cd = rc_context_desc_default();
     rc_scene_desc sd = rc_scene_desc_default();
-    rc_results res = rc_results_default();
     rc_context *ctx = NULL;
     rc_scene *box = NULL, *world = NULL;
     rc_sensor *sensor = NULL;
@@ -31,8 +30,7 @@ int main(int argc, char **argv)
     rc_pose *poses;
     float *ranges;
     uint32_t poses_n, insts, spread, i, id, rays = 16u * 1800u;
-    double best = 1e30, sum = 0.0;
-    int rep;
+    double best, sum;
     if (argc < 4) {
         fprintf(stderr, "usage: %s THREADS BACKEND TRIANGLES [POSES [INSTANCES]]\n", argv[0]);
         return 2;
@@ -81,16 +79,7 @@ int main(int argc, char **argv)
             poses[i].position[1] = 2.0f * sinf((float)i);
         }
     }
-    res.attributes = RC_ATTR_RANGES;
-    res.ranges = ranges;
-    res.capacity = (uint64_t)rays * poses_n;
-    for (rep = 0; rep < 4; ++rep) { /* the first call warms up */
-        const double t0 = now_s();
-        if (rc_simulate(ctx, world, sensor, poses, poses_n, &res) != RC_OK) return fail(ctx, "rc_simulate");
-        if (rep && now_s() - t0 < best) best = now_s() - t0;
-    }
-    for (i = 0; i < rays * poses_n; i += 997u)
-        if (isfinite(ranges[i])) sum += ranges[i];
+    if (probe_time_ranges(ctx, world, sensor, poses, poses_n, rays, ranges, &best, &sum) != 0) return 1;
     printf("%u triangles, %u instances, %u threads: %.1f scans/s (best of 3), range checksum %.6f\n",
            sphere.triangle_count, insts, cd.thread_count, poses_n / best, sum);
     rc_context_destroy(ctx);

@@ -1,0 +1,92 @@
+/* Probe, not part of the build: a depth camera (RealSense D435 preset) in a
+ * room of balls, the scene built as one merged mesh or as one geometry per
+ * object (the room, then each ball). Scenes of several meshes take projected
+ * scans too since session 40; before, they took the packets
+ * (docs/benchmarks.md). Prints the best of three timed calls of POSES poses
+ * and a checksum of the ranges (equal for both layouts: the same triangles).
+ * Uses the public API only.
+ *
+ *   gcc -O2 -std=c99 -Iinclude -Itools/common tools/probes/camera_meshes.c \
+ *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
+ *       [-lembree3] [-lvulkan] -o /tmp/camera_meshes
+ *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS]]]
+ * LAYOUT 0: one merged mesh; 1: the room and each ball a geometry of its own.
+ * BALLS (default 24, at most 31) UV balls of SEGMENTS (default 48) segments
+ * and half as many rings, 0.3 to 0.7 m, on a grid in a 12 x 12 x 3 m room;
+ * poses 1.5 m up, random positions within 4 m of the centre and headings.
+ */
+#include "probe.h" /* first: it asks for POSIX */
+
+#include <math.h>
+#include <stdlib.h>
+
+int main(int argc, char **argv)
+{
+    const float lo[3] = {-6.0f, -6.0f, 0.0f}, hi[3] = {6.0f, 6.0f, 3.0f};
+    rc_context_desc cd = rc_context_desc_default();
+    rc_scene_desc sd = rc_scene_desc_default();
+    rc_context *ctx = NULL;
+    rc_scene *scene = NULL;
+    rc_sensor *sensor = NULL;
+    rcu_mesh room, balls[31], merged;
+    rc_pose *poses;
+    float *ranges;
+    uint32_t layout, nballs, poses_n, segments, rays, i, g;
+    double best, sum;
+    if (argc < 3) {
+        fprintf(stderr, "usage: %s THREADS LAYOUT [BALLS [POSES [SEGMENTS]]]\n", argv[0]);
+        return 2;
+    }
+    cd.thread_count = (uint32_t)atoi(argv[1]);
+    layout = (uint32_t)atoi(argv[2]);
+    nballs = argc > 3 ? (uint32_t)atoi(argv[3]) : 24u;
+    poses_n = argc > 4 ? (uint32_t)atoi(argv[4]) : 60u;
+    segments = argc > 5 ? (uint32_t)atoi(argv[5]) : 48u;
+    if (nballs > 31u || segments < 3u) return fail(NULL, "at most 31 balls, at least 3 segments");
+    cd.memory_size = (size_t)512 << 20;
+    if (rcu_mesh_box(lo, hi, &room) != 0 || rcu_mesh_box(lo, hi, &merged) != 0) return fail(NULL, "room");
+    for (i = 0; i < nballs; ++i) {
+        const float at[3] = {-4.5f + 1.8f * (float)(i % 6u), -4.5f + 1.8f * (float)(i / 6u), 0.5f + 0.4f * (float)(i % 4u)};
+        if (rcu_mesh_uv_sphere(0.3f + 0.1f * (float)(i % 5u), segments, segments / 2u, &balls[i]) != 0)
+            return fail(NULL, "ball");
+        rcu_mesh_transform(&balls[i], 0.0f, at);
+        if (rcu_mesh_append(&merged, &balls[i]) != 0) return fail(NULL, "merge");
+    }
+    if (rc_context_create(&cd, &ctx) != RC_OK) return fail(NULL, "rc_context_create");
+    sd.max_geometries = layout ? nballs + 1u : 1u;
+    sd.max_triangles = merged.triangle_count;
+    if (rc_scene_create(ctx, &sd, &scene) != RC_OK) return fail(ctx, "scene");
+    if (layout) {
+        if (probe_add_mesh(scene, &room, RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "room mesh");
+        for (g = 0; g < nballs; ++g)
+            if (probe_add_mesh(scene, &balls[g], RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "ball mesh");
+    } else if (probe_add_mesh(scene, &merged, RC_MESH_REFERENCE) != RC_OK) {
+        return fail(ctx, "merged mesh");
+    }
+    if (rc_scene_commit(scene) != RC_OK) return fail(ctx, "commit");
+    if (rc_sensor_create_preset(ctx, RC_PRESET_REALSENSE_D435, &sensor) != RC_OK) return fail(ctx, "sensor");
+    rays = 848u * 480u;
+    poses = (rc_pose *)malloc(sizeof *poses * poses_n);
+    ranges = (float *)malloc(sizeof *ranges * rays * (size_t)poses_n);
+    if (!poses || !ranges) return fail(NULL, "memory");
+    srand(1);
+    for (i = 0; i < poses_n; ++i) {
+        const double yaw = 6.283185307179586 * rand() / RAND_MAX;
+        poses[i] = rc_pose_identity();
+        poses[i].position[0] = (float)(8.0 * rand() / RAND_MAX - 4.0);
+        poses[i].position[1] = (float)(8.0 * rand() / RAND_MAX - 4.0);
+        poses[i].position[2] = 1.5f;
+        poses[i].orientation[2] = (float)sin(yaw / 2.0); /* about z: (x, y, z, w) */
+        poses[i].orientation[3] = (float)cos(yaw / 2.0);
+    }
+    if (probe_time_ranges(ctx, scene, sensor, poses, poses_n, rays, ranges, &best, &sum) != 0) return 1;
+    printf("%u triangles in %u geometries, %u threads: %.1f scans/s (best of 3), range checksum %.6f\n",
+           merged.triangle_count, layout ? nballs + 1u : 1u, cd.thread_count, poses_n / best, sum);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&room);
+    rcu_mesh_free(&merged);
+    for (i = 0; i < nballs; ++i) rcu_mesh_free(&balls[i]);
+    free(poses);
+    free(ranges);
+    return 0;
+}
