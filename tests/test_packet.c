@@ -137,6 +137,8 @@ typedef void (*packet_fn)(const rc__mesh *mesh, const rc__ray *rays, uint32_t n,
                           rc__hit *hits, int *found, uint32_t flags);
 typedef void (*packets_fn)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays, const uint32_t *n,
                            uint32_t geom, uint32_t inst, rc__hit *const *hits, int *const *found, uint32_t flags);
+typedef void (*meshes_fn)(const rc__mesh *const *meshes, const uint32_t *geoms, uint32_t count, const rc__ray *rays,
+                          uint32_t n, uint32_t inst, rc__hit *hits, int *found, uint32_t flags);
 
 /* A build of the traversal: the entry points, or one of the two x86-64
  * builds behind them. */
@@ -144,13 +146,16 @@ typedef struct packet_build {
     const char *name;
     packet_fn one;
     packets_fn many;
+    meshes_fn meshes;
 } packet_build;
 
-static const packet_build selected = {"selected by the CPU", rc__mesh_intersect_packet, rc__mesh_intersect_packets};
+static const packet_build selected = {"selected by the CPU", rc__mesh_intersect_packet, rc__mesh_intersect_packets,
+                                      rc__mesh_intersect_packet_meshes};
 #if defined(RC__PACKET_TWO_BUILDS)
 static const packet_build baseline = {"baseline SSE2", rc__mesh_intersect_packet_sse2,
-                                      rc__mesh_intersect_packets_sse2};
-static const packet_build avx2 = {"AVX2", rc__mesh_intersect_packet_avx2, rc__mesh_intersect_packets_avx2};
+                                      rc__mesh_intersect_packets_sse2, rc__mesh_intersect_packet_meshes_sse2};
+static const packet_build avx2 = {"AVX2", rc__mesh_intersect_packet_avx2, rc__mesh_intersect_packets_avx2,
+                                  rc__mesh_intersect_packet_meshes_avx2};
 #endif
 
 static void packet_equals_single(const packet_build *b, uint32_t flags)
@@ -201,6 +206,87 @@ static void packets_in_turns_equal_single(const packet_build *b, uint32_t flags)
         for (j = 0; j < k; ++j) expect_single(t.mesh, rays[j], n[j], hits[j], found[j], flags);
     }
     map_close(&t);
+}
+
+/* One packet through several meshes at once (rc__mesh_intersect_packet_meshes)
+ * against the same packet mesh by mesh: the sphere, the box and a copy of
+ * the box (each hit on the box ties with its copy), given in four orders, one
+ * with the sphere's tree taken away (that mesh then goes ray by ray, and
+ * the lanes are filled for the next one). Every field of every hit the same,
+ * pending prims included. */
+#if defined(RC__PACKET_MESHES)
+static void packet_meshes_equal_meshwise(const packet_build *b, uint32_t flags)
+{
+    static const uint32_t orders[4][3] = {{0, 1, 2}, {2, 1, 0}, {1, 0, 2}, {0, 2, 1}};
+    const int own_origins = (flags & RC__PACKET_OWN_ORIGINS) != 0u;
+    rcu_mesh sphere, box;
+    const rcu_mesh *ms[3];
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_scene *scene;
+    rc__mesh bare;
+    uint32_t tile, tiles = rct_quick() ? 200u : 2000u, ties = 0;
+    print_message("packets through meshes: %s build%s%s\n", b->name, own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(box_lo, box_hi, &box), 0);
+    ms[0] = &sphere;
+    ms[1] = &box;
+    ms[2] = &box;
+    scene = rct_scene_meshes(ctx, ms, 3u);
+    bare = scene->geoms[0].mesh;
+    bare.wide = NULL;
+    bare.wide_count = 0;
+    for (tile = 0; tile < tiles; ++tile) {
+        rc__ray rays[RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKET_SIZE], want[RC__PACKET_SIZE];
+        int found[RC__PACKET_SIZE], want_found[RC__PACKET_SIZE];
+        const uint32_t n = make_tile(tile, rays, hits, found, own_origins), *order = orders[tile % 4u];
+        const rc__mesh *meshes[3];
+        uint32_t geoms[3], i;
+        for (i = 0; i < 3u; ++i) {
+            geoms[i] = order[i];
+            meshes[i] = tile % 8u == 3u && order[i] == 0u ? &bare : &scene->geoms[order[i]].mesh;
+        }
+        memcpy(want, hits, sizeof want);
+        memcpy(want_found, found, sizeof want_found);
+        b->meshes(meshes, geoms, 3u, rays, n, RC_INVALID_ID, hits, found, flags);
+        for (i = 0; i < 3u; ++i) b->one(meshes[i], rays, n, geoms[i], RC_INVALID_ID, want, want_found, flags);
+        for (i = 0; i < n; ++i) {
+            assert_int_equal(found[i], want_found[i]);
+            assert_memory_equal(&hits[i].t, &want[i].t, sizeof(float));
+            assert_int_equal(hits[i].prim, want[i].prim);
+            assert_int_equal(hits[i].geom, want[i].geom);
+            assert_int_equal(hits[i].slot, want[i].slot);
+            ties += found[i] && hits[i].geom == 1u;
+        }
+    }
+    /* the box's hits all tie with its copy's, and the box keeps them */
+    assert_true(ties > 0);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+}
+
+#endif
+
+static void test_packet_meshes_equal_meshwise(void **state)
+{
+    (void)state;
+#if defined(RC__PACKET_MESHES)
+    {
+        uint32_t flags;
+        /* 0, own origins, prim ids pending, both */
+        for (flags = 0; flags < 4u; ++flags) packet_meshes_equal_meshwise(&selected, flags);
+#if defined(RC__PACKET_TWO_BUILDS)
+        packet_meshes_equal_meshwise(&baseline, 0);
+        if (rc__leaf4_have_avx2()) packet_meshes_equal_meshwise(&avx2, RC__PACKET_PRIMS_PENDING);
+#endif
+    }
+#else
+    print_message("an -Os build: packets go mesh by mesh\n");
+    skip();
+#endif
 }
 
 static void test_packet_equals_single(void **state)
@@ -314,6 +400,7 @@ int main(void)
                                        cmocka_unit_test(test_pending_prims_equal_single),
                                        cmocka_unit_test(test_pending_prim_from_another_mesh),
                                        cmocka_unit_test(test_both_builds_equal_single),
+                                       cmocka_unit_test(test_packet_meshes_equal_meshwise),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

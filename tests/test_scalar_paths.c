@@ -12,9 +12,11 @@
 #undef rc__mesh_intersect_rays
 #define rc__mesh_intersect_packet scalar_intersect_packet
 #define rc__mesh_intersect_packets scalar_intersect_packets
+#define rc__mesh_intersect_packet_meshes scalar_intersect_packet_meshes
 #include "../src/bvh/packet.c"
 #undef rc__mesh_intersect_packet
 #undef rc__mesh_intersect_packets
+#undef rc__mesh_intersect_packet_meshes
 #undef rc__mesh_intersect_wide
 #undef rc__mesh_occluded_wide
 

@@ -131,6 +131,9 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         const rc__ray *prays[RC__PACKETS_IN_FLIGHT];
         rc__hit *phits[RC__PACKETS_IN_FLIGHT];
         int *pfound[RC__PACKETS_IN_FLIGHT];
+        /* the meshes each packet goes through alone, all in one call */
+        const rc__mesh *alone[RC__PACKET_MAX_MESHES];
+        uint32_t alone_geoms[RC__PACKET_MAX_MESHES], alone_count = 0;
         for (k = 0; k < group; ++k) {
             prays[k] = rays[k];
             phits[k] = hits[k];
@@ -141,11 +144,22 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
             if (group > 1 && ((run->large >> g) & 1u)) {
                 rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, run->packet_flags);
             } else {
-                for (k = 0; k < group; ++k)
-                    rc__mesh_intersect_packet(mesh, rays[k], n[k], g, RC_INVALID_ID, hits[k], found[k],
-                                              run->packet_flags);
+                alone[alone_count] = mesh;
+                alone_geoms[alone_count++] = g;
             }
         }
+#if defined(RC__PACKET_MESHES)
+        if (alone_count > 1u) {
+            for (k = 0; k < group; ++k)
+                rc__mesh_intersect_packet_meshes(alone, alone_geoms, alone_count, rays[k], n[k], RC_INVALID_ID,
+                                                 hits[k], found[k], run->packet_flags);
+            alone_count = 0;
+        }
+#endif
+        for (g = 0; g < alone_count; ++g)
+            for (k = 0; k < group; ++k)
+                rc__mesh_intersect_packet(alone[g], rays[k], n[k], alone_geoms[g], RC_INVALID_ID, hits[k], found[k],
+                                          run->packet_flags);
     } else if (run->rays_by_mesh) {
         for (g = 0; g < scene->geom_count; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;

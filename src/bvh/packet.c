@@ -997,6 +997,39 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
     }
 }
 
+#if defined(RC__PACKET_MESHES)
+void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *meshes, const uint32_t *geoms,
+                                                     uint32_t count, const rc__ray *rays, uint32_t n, uint32_t inst,
+                                                     rc__hit *hits, int *found, uint32_t flags)
+{
+    packet_trav T;
+    uint32_t m = 0;
+    int filled = 0;
+    if (n > 0 && n <= LANES)
+        for (; m < count; ++m) {
+            const rc__mesh *mesh = meshes[m];
+            if (mesh->wide == NULL || mesh->wide_count == 0) {
+                RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays, n, geoms[m], inst, hits, found, flags);
+                continue;
+            }
+            if (!filled) {
+                /* mixed octants: every mesh the usual way below */
+                if (!trav_init(&T, mesh, rays, n, hits, found, flags)) break;
+                filled = 1;
+            } else {
+                /* the lanes stay filled (their tmax the hits' so far, P.tmax
+                 * their largest): the traversal starts over at the root */
+                T.mask = (n >= 32u ? 0u : (1u << n)) - 1u;
+                T.sp = T.child = T.count = 0;
+                T.staged = T.settling = 0;
+            }
+            while (trav_step(&T, mesh, geoms[m], inst, 0)) {
+            }
+        }
+    for (; m < count; ++m) RC__PACKET_FN(rc__mesh_intersect_packet)(meshes[m], rays, n, geoms[m], inst, hits, found, flags);
+}
+#endif
+
 void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                                const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,
                                                int *const *found, uint32_t flags)
@@ -1031,6 +1064,18 @@ void rc__mesh_intersect_packet(const rc__mesh *mesh, const rc__ray *rays, uint32
     else
         rc__mesh_intersect_packet_sse2(mesh, rays, n, geom, inst, hits, found, flags);
 }
+
+#if defined(RC__PACKET_MESHES)
+void rc__mesh_intersect_packet_meshes(const rc__mesh *const *meshes, const uint32_t *geoms, uint32_t count,
+                                      const rc__ray *rays, uint32_t n, uint32_t inst, rc__hit *hits, int *found,
+                                      uint32_t flags)
+{
+    if (rc__leaf4_have_avx2())
+        rc__mesh_intersect_packet_meshes_avx2(meshes, geoms, count, rays, n, inst, hits, found, flags);
+    else
+        rc__mesh_intersect_packet_meshes_sse2(meshes, geoms, count, rays, n, inst, hits, found, flags);
+}
+#endif
 
 void rc__mesh_intersect_packets(const rc__mesh *mesh, uint32_t packets, const rc__ray *const *rays,
                                 const uint32_t *n, uint32_t geom, uint32_t inst, rc__hit *const *hits,

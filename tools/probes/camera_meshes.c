@@ -9,11 +9,13 @@
  *   gcc -O2 -std=c99 -Iinclude -Itools/common tools/probes/camera_meshes.c \
  *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
  *       [-lembree3] [-lvulkan] -o /tmp/camera_meshes
- *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS]]]
+ *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS [PRESET]]]]
  * LAYOUT 0: one merged mesh; 1: the room and each ball a geometry of its own.
  * BALLS (default 24, at most 31) UV balls of SEGMENTS (default 48) segments
  * and half as many rings, 0.3 to 0.7 m, on a grid in a 12 x 12 x 3 m room;
  * poses 1.5 m up, random positions within 4 m of the centre and headings.
+ * PRESET: the sensor, an RC_PRESET_* number (default 3, the D435; 1 the
+ * VLP-16).
  */
 #include "probe.h" /* first: it asks for POSIX */
 
@@ -28,10 +30,11 @@ int main(int argc, char **argv)
     rc_context *ctx = NULL;
     rc_scene *scene = NULL;
     rc_sensor *sensor = NULL;
+    rc_sensor_info info = rc_sensor_info_default();
     rcu_mesh room, balls[31], merged;
     rc_pose *poses;
     float *ranges;
-    uint32_t layout, nballs, poses_n, segments, rays, i, g;
+    uint32_t layout, nballs, poses_n, segments, preset, rays, i, g;
     double best, sum;
     if (argc < 3) {
         fprintf(stderr, "usage: %s THREADS LAYOUT [BALLS [POSES [SEGMENTS]]]\n", argv[0]);
@@ -42,6 +45,7 @@ int main(int argc, char **argv)
     nballs = argc > 3 ? (uint32_t)atoi(argv[3]) : 24u;
     poses_n = argc > 4 ? (uint32_t)atoi(argv[4]) : 60u;
     segments = argc > 5 ? (uint32_t)atoi(argv[5]) : 48u;
+    preset = argc > 6 ? (uint32_t)atoi(argv[6]) : RC_PRESET_REALSENSE_D435;
     if (nballs > 31u || segments < 3u) return fail(NULL, "at most 31 balls, at least 3 segments");
     cd.memory_size = (size_t)512 << 20;
     if (rcu_mesh_box(lo, hi, &room) != 0 || rcu_mesh_box(lo, hi, &merged) != 0) return fail(NULL, "room");
@@ -64,8 +68,9 @@ int main(int argc, char **argv)
         return fail(ctx, "merged mesh");
     }
     if (rc_scene_commit(scene) != RC_OK) return fail(ctx, "commit");
-    if (rc_sensor_create_preset(ctx, RC_PRESET_REALSENSE_D435, &sensor) != RC_OK) return fail(ctx, "sensor");
-    rays = 848u * 480u;
+    if (rc_sensor_create_preset(ctx, preset, &sensor) != RC_OK || rc_sensor_get_info(sensor, &info) != RC_OK)
+        return fail(ctx, "sensor");
+    rays = info.rays_per_scan;
     poses = (rc_pose *)malloc(sizeof *poses * poses_n);
     ranges = (float *)malloc(sizeof *ranges * rays * (size_t)poses_n);
     if (!poses || !ranges) return fail(NULL, "memory");
