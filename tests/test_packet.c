@@ -270,6 +270,100 @@ static void packet_meshes_equal_meshwise(const packet_build *b, uint32_t flags)
 
 #endif
 
+/* A packet through a scene of 43 meshes (more than the packets take mesh
+ * by mesh): the top-level walk, its interval box test and its batches of
+ * RC__SCENE_PACKET_BATCH give each ray rc__scene_intersect_items's hit. The
+ * small boxes share planes with the tiles' origins (make_tile) and the big
+ * box has a copy (ties across the batches); some tiles leave the sphere and
+ * the copy to the caller (skip), some start from nearer hits. */
+static void scene_packet_equals_items(uint32_t flags)
+{
+    enum { SMALL = 40, MESHES = SMALL + 3 };
+    const int own_origins = (flags & RC__PACKET_OWN_ORIGINS) != 0u;
+    rcu_mesh sphere, box, small[SMALL];
+    const rcu_mesh *ms[MESHES];
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_scene *scene;
+    uint32_t tile, tiles = rct_quick() ? 200u : 2000u, j, met[MESHES] = {0}, geoms_met = 0;
+    print_message("a packet through 43 meshes%s%s\n", own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 60, 30, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(box_lo, box_hi, &box), 0);
+    ms[0] = &sphere;
+    ms[1] = &box;
+    ms[2] = &box;
+    for (j = 0; j < SMALL; ++j) {
+        float lo[3], hi[3];
+        uint32_t k;
+        lo[0] = -9.0f + 4.0f * (float)(j % 5u);
+        lo[1] = -9.0f + 5.0f * (float)((j / 5u) % 4u);
+        lo[2] = -4.0f + 5.0f * (float)(j / 20u);
+        for (k = 0; k < 3; ++k) hi[k] = lo[k] + 0.5f + 0.25f * (float)((j + k) % 4u);
+        /* every third box on a plane of the big box's: the origins of
+         * make_tile's planar and axis tiles */
+        if (j % 3u == 0) {
+            k = (j / 3u) % 3u;
+            lo[k] = j % 2u ? box_lo[k] : box_hi[k];
+            hi[k] = lo[k] + 0.75f;
+        }
+        assert_int_equal(rcu_mesh_box(lo, hi, &small[j]), 0);
+        ms[3 + j] = &small[j];
+    }
+    scene = rct_scene_meshes(ctx, ms, MESHES);
+    for (tile = 0; tile < tiles; ++tile) {
+        rc__ray rays[RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKET_SIZE], want[RC__PACKET_SIZE];
+        int found[RC__PACKET_SIZE], want_found[RC__PACKET_SIZE];
+        const uint32_t n = make_tile(tile, rays, hits, found, own_origins), skip = tile % 3u == 1u ? 5u : 0u;
+        uint32_t i;
+        if (tile % 4u == 2u)
+            for (i = 0; i < n; i += 2u) hits[i].t = 4.0f;
+        memcpy(want, hits, sizeof want);
+        memcpy(want_found, found, sizeof want_found);
+        rc__scene_intersect_packet(scene, rays, n, skip, hits, found, flags);
+        for (j = 0; j < 32u; ++j)
+            if ((skip >> j) & 1u)
+                rc__mesh_intersect_packet(&scene->geoms[j].mesh, rays, n, j, RC_INVALID_ID, hits, found, flags);
+        for (i = 0; i < n; ++i) want_found[i] |= rc__scene_intersect_items(scene, &rays[i], &want[i], 0u);
+        for (i = 0; i < n; ++i) {
+            rc__hit h = hits[i];
+            assert_int_equal(found[i], want_found[i]);
+            if (!found[i]) continue;
+            assert_memory_equal(&h.t, &want[i].t, sizeof(float));
+            assert_int_equal(h.geom, want[i].geom);
+            if (h.prim == RC__PRIM_PENDING) {
+                assert_true(flags & RC__PACKET_PRIMS_PENDING);
+                rc__hit_settle(&h, scene->geoms[h.geom].mesh.bvh.refs);
+            }
+            assert_int_equal(h.prim, want[i].prim);
+            geoms_met += met[h.geom]++ == 0u;
+        }
+    }
+    /* most meshes were met, and the box won every tie with its copy */
+    assert_true(geoms_met >= 30u);
+    assert_int_equal(met[2], 0u);
+    assert_true(met[1] > 0u);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+    for (j = 0; j < SMALL; ++j) rcu_mesh_free(&small[j]);
+}
+
+static void test_scene_packet_equals_items(void **state)
+{
+    (void)state;
+#if defined(RC__PACKET_MESHES)
+    {
+        uint32_t flags;
+        for (flags = 0; flags < 4u; ++flags) scene_packet_equals_items(flags);
+    }
+#else
+    print_message("an -Os build: scenes of many meshes go ray by ray\n");
+    skip();
+#endif
+}
+
 static void test_packet_meshes_equal_meshwise(void **state)
 {
     (void)state;
@@ -401,6 +495,7 @@ int main(void)
                                        cmocka_unit_test(test_pending_prim_from_another_mesh),
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_packet_meshes_equal_meshwise),
+                                       cmocka_unit_test(test_scene_packet_equals_items),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

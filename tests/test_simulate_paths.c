@@ -60,7 +60,7 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
 {
     rc_pose poses[POSES];
     rct_buffers buf;
-    uint32_t p, i, hits = 0, box_hits = 0, inst_hits = 0;
+    uint32_t p, i, hits = 0, box_hits = 0, inst_hits = 0, small_hits = 0;
     poses[0] = rct_pose(0.0f, 0.0f, 0.0f);
     poses[1] = rct_pose(3.0f, -2.0f, 1.0f);
     rct_buffers_alloc(&buf, (uint64_t)POSES * rays,
@@ -91,6 +91,7 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
             assert_int_equal(buf.res.hits[at], want != RC_INVALID_ID);
             hits += buf.res.hits[at];
             box_hits += want_geom == 1u && want_inst == RC_INVALID_ID;
+            small_hits += want_geom >= 3u && want_geom != RC_INVALID_ID && want_inst == RC_INVALID_ID;
         }
     /* every origin is inside the closed sphere (an OnDn origin may sit just
      * on a box); with the boxes in the scene, some rays end on them (on
@@ -98,6 +99,7 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
     assert_true(hits + 2u >= POSES * rays);
     if (scene->geom_count > 1 && scene->inst_count == 0) assert_true(box_hits > 0);
     if (scene->inst_count > 0) assert_true(inst_hits > 0);
+    if (scene->geom_count > 3) assert_true(small_hits > 0);
     rct_buffers_free(&buf);
 }
 
@@ -159,24 +161,33 @@ static void check_distances(const rc_scene *scene, const rc_sensor *s, uint32_t 
 }
 #endif
 
+/* Small boxes that make a scene of more meshes than the packets take mesh
+ * by mesh (RC__PACKET_MAX_MESHES): the top-level walk a packet */
+#define SMALL_BOXES 37u
+static rcu_mesh small_boxes[SMALL_BOXES];
+
 /* A scene of the sphere and, with boxes 1, a box (geometry 1) and the same
  * box again (geometry 2), all referenced; with boxes 2 also two instances of
  * a scene of the box, one where the own box is (hits there tie between
  * geometry 1 and instance 0, which the instance wins: the tie rule orders
  * by instance id first, and own meshes have none) and one turned beside it
- * (*src holds that scene). */
+ * (*src holds that scene). Boxes 3 and 4: as 1 and 2 with the small boxes
+ * after the three meshes (40 meshes). */
 static rc_scene *make_scene(rc_context *ctx, const rcu_mesh *sphere, const rcu_mesh *box, int boxes, rc_scene **src)
 {
-    const rcu_mesh *parts[3];
+    const rcu_mesh *parts[3 + SMALL_BOXES];
+    const uint32_t count = boxes >= 3 ? 3u + SMALL_BOXES : boxes ? 3u : 1u;
+    uint32_t j;
     rc_pose at[2];
     parts[0] = sphere;
     parts[1] = parts[2] = box;
+    for (j = 0; j < SMALL_BOXES; ++j) parts[3 + j] = &small_boxes[j];
     *src = NULL;
-    if (boxes < 2) return rct_scene_meshes(ctx, parts, boxes ? 3u : 1u);
+    if (boxes != 2 && boxes != 4) return rct_scene_meshes(ctx, parts, count);
     *src = rct_scene_meshes(ctx, &box, 1u);
     at[0] = rct_pose(0.0f, 0.0f, 0.0f);
     at[1] = rct_pose_ypr(-9.0f, 3.0f, 0.0f, 0.7, 0.0, 0.2);
-    return rct_scene_instanced(ctx, parts, 3u, *src, at, 2u);
+    return rct_scene_instanced(ctx, parts, count, *src, at, 2u);
 }
 
 /* orgs: origins up to 5 m apart (single rays); beams: up to 6 cm apart
@@ -231,6 +242,16 @@ static void test_simulate_paths(void **state)
     /* 2 x 560 x 280 = 313,600 triangles: above the threshold's floor */
     assert_int_equal(rcu_mesh_uv_sphere(20.0f, 560, 280, &sphere), 0);
     assert_int_equal(rcu_mesh_box(lo, hi, &box), 0);
+    for (i = 0; i < SMALL_BOXES; ++i) {
+        /* on a ring 9 to 15 m out, some across the sweep's pitch */
+        const double yaw = 6.283185307 * i / SMALL_BOXES, r = 9.0 + 6.0 * (i % 3u) / 2.0;
+        float blo[3], bhi[3];
+        blo[0] = (float)(r * cos(yaw));
+        blo[1] = (float)(r * sin(yaw));
+        blo[2] = -3.0f + 1.5f * (float)(i % 4u);
+        for (k = 0; k < 3; ++k) bhi[k] = blo[k] + 0.6f + 0.3f * (float)((i + k) % 3u);
+        assert_int_equal(rcu_mesh_box(blo, bhi, &small_boxes[i]), 0);
+    }
     for (i = 0; i < rays; ++i) {
         /* a sweep in scan order (coherent runs for packets) and random
          * origins within 5 m for OnDn */
@@ -250,6 +271,11 @@ static void test_simulate_paths(void **state)
     /* instances after packets and runs, taking turns or not */
     run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 2, dirs, orgs, beams, rays);
     run_paths(&sphere, &box, UINT64_MAX, 2, dirs, orgs, beams, rays);
+    /* many meshes: the top-level walk a packet (the sphere taking turns,
+     * or not and with instances after) */
+    run_paths(&sphere, &box, RC__LARGE_MESH_BYTES, 3, dirs, orgs, beams, rays);
+    run_paths(&sphere, &box, UINT64_MAX, 4, dirs, orgs, beams, rays);
+    for (i = 0; i < SMALL_BOXES; ++i) rcu_mesh_free(&small_boxes[i]);
     rcu_mesh_free(&sphere);
     rcu_mesh_free(&box);
     free(dirs);

@@ -3,8 +3,9 @@
  * context's thread pool. Rays of a scan are traced in tiles (neighbouring rows
  * and columns of a grid sensor, or runs of consecutive O1Dn rays) that share
  * the sensor's origin, so the packet traversal serves a tile per node fetch
- * (mesh by mesh in scenes of up to RC__PACKET_MAX_MESHES meshes and no
- * instances; other scenes go ray by ray through the scene's top-level tree).
+ * (mesh by mesh in scenes of up to RC__PACKET_MAX_MESHES meshes, a packet's
+ * walk of the top-level tree in scenes of more; instances after them ray
+ * by ray).
  * Work is split into tasks of one pose, or of a slice of a pose's tiles when
  * there are fewer poses than threads can keep busy; on a mesh larger than the
  * cache, of a chunk of poses whose tiles run in the order of the mesh's tree
@@ -26,6 +27,14 @@
  * map cut into M meshes, 1 thread, against ray by ray: M = 2 +56%, 8 +34%,
  * 16 +30%, 32 +13%, 64 even, 128 -18%). */
 #define RC__PACKET_MAX_MESHES 32u
+/* Scenes of more meshes walk their top-level tree a packet
+ * (rc__scene_intersect_packet) where the build has it; -Os builds send
+ * their rays one by one. */
+#if defined(RC__PACKET_MESHES)
+#define RC__PACKET_SCENE_MESHES UINT32_MAX
+#else
+#define RC__PACKET_SCENE_MESHES RC__PACKET_MAX_MESHES
+#endif
 /* Projected scans (scan_raster.h) for meshes of at most this many triangles
  * per ray of the scan. On the sphere against the packets (session 32, one
  * thread each, run side by side on the two cores): a VLP-16 (14,400 rays)
@@ -134,12 +143,13 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         /* the meshes each packet goes through alone, all in one call */
         const rc__mesh *alone[RC__PACKET_MAX_MESHES];
         uint32_t alone_geoms[RC__PACKET_MAX_MESHES], alone_count = 0;
+        const uint32_t direct = scene->geom_count <= RC__PACKET_MAX_MESHES ? scene->geom_count : RC__PACKET_MAX_MESHES;
         for (k = 0; k < group; ++k) {
             prays[k] = rays[k];
             phits[k] = hits[k];
             pfound[k] = found[k];
         }
-        for (g = 0; g < scene->geom_count; ++g) {
+        for (g = 0; g < direct; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
             if (group > 1 && ((run->large >> g) & 1u)) {
                 rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, run->packet_flags);
@@ -149,7 +159,14 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
             }
         }
 #if defined(RC__PACKET_MESHES)
-        if (alone_count > 1u) {
+        if (direct < scene->geom_count) {
+            /* many meshes: all but those taking turns go through the
+             * top-level tree a packet */
+            for (k = 0; k < group; ++k)
+                rc__scene_intersect_packet(scene, rays[k], n[k], group > 1 ? run->large : 0u, hits[k], found[k],
+                                           run->packet_flags);
+            alone_count = 0;
+        } else if (alone_count > 1u) {
             for (k = 0; k < group; ++k)
                 rc__mesh_intersect_packet_meshes(alone, alone_geoms, alone_count, rays[k], n[k], RC_INVALID_ID,
                                                  hits[k], found[k], run->packet_flags);
@@ -522,22 +539,24 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     run.tiles = run.tl.grid_rows * run.tl.grid_cols;
     /* Packets need one shared origin, or origins close together (an OnDn
      * sensor's beams: packet.c) (instances are searched ray by ray after
-     * them); a scene of many meshes goes ray by ray through its top-level
-     * tree instead of testing every mesh's root per tile. */
+     * them); a scene of many meshes walks its top-level tree a packet
+     * instead of testing every mesh's root per tile, or in -Os builds goes
+     * ray by ray. */
     run.packet_flags = (s->origins != NULL ? RC__PACKET_OWN_ORIGINS : 0u) |
                        (job->attributes & (RC_ATTR_PRIM_IDS | RC_ATTR_NORMALS) ? 0u : RC__PACKET_PRIMS_PENDING);
     run.packets = (s->origins == NULL || s->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD) &&
-                  job->scene->geom_count >= 1 && job->scene->geom_count <= RC__PACKET_MAX_MESHES;
+                  job->scene->geom_count >= 1 && job->scene->geom_count <= RC__PACKET_SCENE_MESHES;
 #if defined(RANGECAST_NO_PACKETS) /* benchmarking switch: single rays only */
     run.packets = 0;
 #endif
-    if (job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
+    if (run.packets || job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
         uint32_t g;
-        for (g = 0; g < job->scene->geom_count; ++g)
+        for (g = 0; g < job->scene->geom_count && g < RC__PACKET_MAX_MESHES; ++g)
             if (rc__mesh_is_large(&job->scene->geoms[g].mesh, ctx->large_mesh_bytes)) run.large |= 1u << g;
     }
-    /* packets of a large mesh take turns; single rays (OnDn) go mesh by mesh
-     * when a large mesh lets them take turns, 128 rays a run */
+    /* packets of a large mesh take turns (in a scene of many meshes, of
+     * one among the first 32); single rays (OnDn) go mesh by mesh when a
+     * large mesh lets them take turns, 128 rays a run */
     run.rays_by_mesh = !run.packets && run.large != 0;
     run.in_flight = run.large ? RC__PACKETS_IN_FLIGHT : 1u;
     run.slices = 1;

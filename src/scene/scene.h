@@ -5,6 +5,7 @@
 #define RC_SCENE_SCENE_H
 
 #include "bvh/mesh.h"
+#include "bvh/packet.h" /* RC__PACKET_MESHES */
 #include "core/context.h"
 #include "core/rmath.h"
 
@@ -105,6 +106,21 @@ static inline int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray,
 {
     return rc__scene_intersect_items(scene, ray, hit, 0u);
 }
+
+#if defined(RC__PACKET_MESHES)
+/* Meshes a packet walks together: at most this many a call of
+ * rc__mesh_intersect_packet_meshes. */
+#define RC__SCENE_PACKET_BATCH 32u
+/* A packet (rc__mesh_intersect_packet's rays, n, hits, found and flags)
+ * through the scene's own meshes, any number of them: the top-level tree
+ * is walked once for the whole packet, and the meshes some ray of it may
+ * meet go through rc__mesh_intersect_packet_meshes, RC__SCENE_PACKET_BATCH
+ * at a time. Meshes g < 32 with bit g of skip set are left out (the caller
+ * traces them another way); instances are left out. The same hits as
+ * rc__scene_intersect_items ray by ray up to the instances. */
+void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
+                                int *found, uint32_t flags);
+#endif
 
 /* The hit's distance recomputed in double: the ray (sensor-frame direction
  * dir_s and origin org_s, NULL for the sensor's own origin, through the

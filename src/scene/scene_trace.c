@@ -1,5 +1,7 @@
 /* Nearest-hit search through a scene's two levels: the top BVH over geometries
- * and instances, then each mesh's BVH (instances in their own frame). */
+ * and instances, then each mesh's BVH (instances in their own frame); a
+ * packet's walk of the top level for scenes of many meshes; the hits'
+ * distances refined in double. */
 #include "scene/scene.h"
 
 #include "bvh/intersect.h"
@@ -88,6 +90,108 @@ int rc__scene_intersect_items(const rc_scene *scene, const rc__ray *ray, rc__hit
     }
     return found;
 }
+
+#if defined(RC__PACKET_MESHES)
+/* A packet through a scene of many meshes (rc__scene_intersect_packet): the
+ * top-level tree walked once for the whole packet. */
+/* What a packet's rays span, for the top-level walk: per axis the range of
+ * their origins and of their inverse directions, and the farthest hit so far. */
+typedef struct packet_span {
+    float org_lo[3], org_hi[3], inv_lo[3], inv_hi[3], tmax;
+} packet_span;
+
+static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits, packet_span *s)
+{
+    uint32_t i, k;
+    for (k = 0; k < 3; ++k) {
+        s->org_lo[k] = s->org_hi[k] = rays[0].org[k];
+        s->inv_lo[k] = s->inv_hi[k] = rays[0].inv_dir[k];
+    }
+    s->tmax = hits[0].t;
+    for (i = 1; i < n; ++i) {
+        for (k = 0; k < 3; ++k) {
+            const float o = rays[i].org[k], v = rays[i].inv_dir[k];
+            s->org_lo[k] = o < s->org_lo[k] ? o : s->org_lo[k];
+            s->org_hi[k] = o > s->org_hi[k] ? o : s->org_hi[k];
+            s->inv_lo[k] = v < s->inv_lo[k] ? v : s->inv_lo[k];
+            s->inv_hi[k] = v > s->inv_hi[k] ? v : s->inv_hi[k];
+        }
+        if (hits[i].t > s->tmax) s->tmax = hits[i].t;
+    }
+}
+
+/* 0 only when no ray of the span can pass box_hit against the box: each
+ * ray's slab distances lie between the extremes of the interval products
+ * (float rounding is monotone, so this holds for the rounded values box_hit
+ * computes too). An axis whose inverse directions change sign, or whose
+ * products are undefined (0 * inf), constrains nothing. */
+static int packet_span_box_hit(const packet_span *s, const float bmin[3], const float bmax[3])
+{
+    float t0 = 0.0f, t1 = s->tmax;
+    int k;
+    for (k = 0; k < 3; ++k) {
+        float d[4], lo, hi;
+        int j, undefined = 0;
+        if (!(s->inv_lo[k] >= 0.0f || s->inv_hi[k] <= 0.0f)) continue;
+        d[0] = bmin[k] - s->org_hi[k];
+        d[1] = bmin[k] - s->org_lo[k];
+        d[2] = bmax[k] - s->org_hi[k];
+        d[3] = bmax[k] - s->org_lo[k];
+        lo = hi = d[0] * s->inv_lo[k];
+        for (j = 0; j < 8; ++j) {
+            const float p = d[j >> 1] * (j & 1 ? s->inv_hi[k] : s->inv_lo[k]);
+            undefined |= p != p;
+            lo = p < lo ? p : lo;
+            hi = p > hi ? p : hi;
+        }
+        if (undefined) continue; /* 0 * inf met */
+        if (lo > t0) t0 = lo;
+        if (hi < t1) t1 = hi;
+    }
+    return t0 <= t1 * RC__SLAB_FAR_SCALE;
+}
+
+void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
+                                int *found, uint32_t flags)
+{
+    uint32_t stack[RC__BVH_MAX_DEPTH + 1];
+    const rc__mesh *batch[RC__SCENE_PACKET_BATCH];
+    uint32_t batch_geoms[RC__SCENE_PACKET_BATCH];
+    uint32_t sp = 0, ni = 0, count = 0;
+    const rc__bvh *top = &scene->top;
+    packet_span span;
+    if (n == 0 || top->node_count == 0) return;
+    packet_span_of(rays, n, hits, &span);
+    for (;;) {
+        const rc__bvh_node *nd = &top->nodes[ni];
+        if (packet_span_box_hit(&span, nd->bmin, nd->bmax)) {
+            if (nd->count == 0) {
+                stack[sp++] = nd->index + 1; /* depth is capped by the builder */
+                ni = nd->index;
+                continue;
+            } else {
+                uint32_t k;
+                for (k = 0; k < nd->count; ++k) {
+                    const uint32_t item = top->refs[nd->index + k];
+                    if (item >= scene->geom_count || (item < 32u && ((skip >> item) & 1u))) continue;
+                    batch[count] = &scene->geoms[item].mesh;
+                    batch_geoms[count++] = item;
+                    if (count == RC__SCENE_PACKET_BATCH) {
+                        /* the hits found so far narrow the rest of the walk */
+                        rc__mesh_intersect_packet_meshes(batch, batch_geoms, count, rays, n, RC_INVALID_ID, hits,
+                                                         found, flags);
+                        count = 0;
+                        packet_span_of(rays, n, hits, &span);
+                    }
+                }
+            }
+        }
+        if (sp == 0) break;
+        ni = stack[--sp];
+    }
+    if (count) rc__mesh_intersect_packet_meshes(batch, batch_geoms, count, rays, n, RC_INVALID_ID, hits, found, flags);
+}
+#endif
 
 /* The mesh of a hit and its instance transform (NULL without one). */
 static const rc__mesh *hit_mesh(const rc_scene *scene, const rc__hit *hit, const rc__xformf **x)

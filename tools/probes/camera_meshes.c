@@ -9,13 +9,15 @@
  *   gcc -O2 -std=c99 -Iinclude -Itools/common tools/probes/camera_meshes.c \
  *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
  *       [-lembree3] [-lvulkan] -o /tmp/camera_meshes
- *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS [PRESET]]]]
+ *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS [PRESET [BACKEND]]]]]
  * LAYOUT 0: one merged mesh; 1: the room and each ball a geometry of its own.
- * BALLS (default 24, at most 31) UV balls of SEGMENTS (default 48) segments
- * and half as many rings, 0.3 to 0.7 m, on a grid in a 12 x 12 x 3 m room;
+ * BALLS (default 24, at most 1024) UV balls of SEGMENTS (default 48) segments
+ * and half as many rings, 0.3 to 0.7 m, on a 6 x 6 grid in a 12 x 12 x 3 m
+ * room (more than 36 balls: a finer grid, the balls smaller in proportion);
  * poses 1.5 m up, random positions within 4 m of the centre and headings.
  * PRESET: the sensor, an RC_PRESET_* number (default 3, the D435; 1 the
- * VLP-16).
+ * VLP-16). BACKEND: an RC_BACKEND_* number (default 1, the built-in BVH;
+ * 2 Embree).
  */
 #include "probe.h" /* first: it asks for POSIX */
 
@@ -31,13 +33,13 @@ int main(int argc, char **argv)
     rc_scene *scene = NULL;
     rc_sensor *sensor = NULL;
     rc_sensor_info info = rc_sensor_info_default();
-    rcu_mesh room, balls[31], merged;
+    rcu_mesh room, *balls, merged;
     rc_pose *poses;
     float *ranges;
-    uint32_t layout, nballs, poses_n, segments, preset, rays, i, g;
+    uint32_t layout, nballs, poses_n, segments, preset, cols, rays, i, g;
     double best, sum;
     if (argc < 3) {
-        fprintf(stderr, "usage: %s THREADS LAYOUT [BALLS [POSES [SEGMENTS]]]\n", argv[0]);
+        fprintf(stderr, "usage: %s THREADS LAYOUT [BALLS [POSES [SEGMENTS [PRESET [BACKEND]]]]]\n", argv[0]);
         return 2;
     }
     cd.thread_count = (uint32_t)atoi(argv[1]);
@@ -46,12 +48,20 @@ int main(int argc, char **argv)
     poses_n = argc > 4 ? (uint32_t)atoi(argv[4]) : 60u;
     segments = argc > 5 ? (uint32_t)atoi(argv[5]) : 48u;
     preset = argc > 6 ? (uint32_t)atoi(argv[6]) : RC_PRESET_REALSENSE_D435;
-    if (nballs > 31u || segments < 3u) return fail(NULL, "at most 31 balls, at least 3 segments");
+    cd.backend = argc > 7 ? (uint32_t)atoi(argv[7]) : RC_BACKEND_BVH;
+    if (nballs > 1024u || segments < 3u) return fail(NULL, "at most 1024 balls, at least 3 segments");
+    balls = (rcu_mesh *)calloc(nballs + 1u, sizeof *balls);
+    if (!balls) return fail(NULL, "memory");
+    for (cols = 6u; nballs > 36u && cols * cols < nballs;) ++cols;
     cd.memory_size = (size_t)512 << 20;
     if (rcu_mesh_box(lo, hi, &room) != 0 || rcu_mesh_box(lo, hi, &merged) != 0) return fail(NULL, "room");
     for (i = 0; i < nballs; ++i) {
-        const float at[3] = {-4.5f + 1.8f * (float)(i % 6u), -4.5f + 1.8f * (float)(i / 6u), 0.5f + 0.4f * (float)(i % 4u)};
-        if (rcu_mesh_uv_sphere(0.3f + 0.1f * (float)(i % 5u), segments, segments / 2u, &balls[i]) != 0)
+        /* up to 36 balls on session 40's 6 x 6 grid; more on a finer one,
+         * the balls smaller in proportion */
+        const float step = 10.8f / (float)cols, scale = step / 1.8f;
+        const float at[3] = {-5.4f + step * (0.5f + (float)(i % cols)), -5.4f + step * (0.5f + (float)(i / cols)),
+                             0.5f + 0.4f * (float)(i % 4u)};
+        if (rcu_mesh_uv_sphere(scale * (0.3f + 0.1f * (float)(i % 5u)), segments, segments / 2u, &balls[i]) != 0)
             return fail(NULL, "ball");
         rcu_mesh_transform(&balls[i], 0.0f, at);
         if (rcu_mesh_append(&merged, &balls[i]) != 0) return fail(NULL, "merge");
@@ -91,6 +101,7 @@ int main(int argc, char **argv)
     rcu_mesh_free(&room);
     rcu_mesh_free(&merged);
     for (i = 0; i < nballs; ++i) rcu_mesh_free(&balls[i]);
+    free(balls);
     free(poses);
     free(ranges);
     return 0;
