@@ -339,8 +339,9 @@ static void scene_packet_equals_items(uint32_t flags)
             geoms_met += met[h.geom]++ == 0u;
         }
     }
-    /* most meshes were met, and the box won every tie with its copy */
-    assert_true(geoms_met >= 30u);
+    /* many meshes were met (22 of 43 in the quick run's 200 tiles, 42 in
+     * 2,000), and the box won every tie with its copy */
+    assert_true(geoms_met >= (rct_quick() ? 15u : 30u));
     assert_int_equal(met[2], 0u);
     assert_true(met[1] > 0u);
     rc_scene_destroy(scene);
