@@ -859,7 +859,8 @@ RC_API rc_status rc_context_get_device_results(rc_context *ctx, rc_device_result
  * (faster on maps the cache cannot hold); without that room they run scan by
  * scan. The built-in backend, for a spherical, cylindrical or pinhole sensor
  * on a scene of up to 32 meshes holding together at most one triangle per ray
- * of the scan, and no instances, borrows 21 bytes a ray a thread (at most
+ * of the scan (for a spherical or cylindrical one, none with an edge longer
+ * than a tenth of the meshes' bounding box diagonal), and no instances, borrows 21 bytes a ray a thread (at most
  * RC_SIMULATE_SCRATCH_PER_THREAD: a larger scan goes in bands of rows) to
  * trace each scan triangle by triangle instead (docs/architecture.md,
  * "Projected scans"); a call of fewer than four scans a thread cuts each into

@@ -43,6 +43,11 @@ struct rc_context {
      * 2 threads, one tile at a time against turns measured 1M triangles
      * (30 MiB) +19%, 2M +5%, 4M +3.5%, 10M -3%. */
     uint64_t ordered_turns_bytes;
+    /* A spinning sensor's projected scan needs every triangle's edges at
+     * most this fraction of the map's bounding box diagonal (the built-in
+     * backend's RC__RASTER_EDGE_FRACTION; tests raise it to put rooms
+     * through the projected scans). */
+    double raster_edge_fraction;
     rc_log_fn log;
     void *log_user;
     struct rc_scene *scenes;        /* singly linked, newest first */
