@@ -744,7 +744,7 @@ static void test_large_triangles(void **state)
     rc_sensor *vlp, *cyl, *cam;
     (void)state;
     assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
-    /* 32 x 16 segments: edges of 2.5 m against a diagonal of 28 m */
+    /* 32 x 16 segments: edges of at most 2.3 m against a diagonal of 28 m */
     assert_int_equal(rcu_mesh_uv_sphere(8.0f, 32u, 16u, &ball), 0);
     room_scene = rct_scene_mesh(ctx, &room, RC_MESH_REFERENCE);
     ball_scene = rct_scene_mesh(ctx, &ball, RC_MESH_REFERENCE);

@@ -448,7 +448,7 @@ int rc__raster_grid_of(const rc_sensor *s, rc__raster_grid *g)
  * traced 335 scans/s so, Embree 1,700, and in an empty 12 x 12 x 3 m box
  * (12 triangles) 444, Embree 1,052. Such maps take the packets: 1 when no
  * triangle's edge is longer than this fraction of the meshes' bounding box
- * diagonal (the 1k sphere's longest, 3.9 m of 69 m, passes). A pass over
+ * diagonal (the 1k sphere's longest, 5.4 m of 69 m, passes). A pass over
  * the triangles, at most one a ray, a call. (A camera's scan clips each
  * triangle to its view and pays no such cost.) */
 #define RC__RASTER_EDGE_FRACTION 0.1
