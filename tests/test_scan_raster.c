@@ -715,18 +715,75 @@ static void compare_calls(rc_context *ctx, rc_context *tight, const rcu_mesh *co
 }
 
 /* 1 when rc_simulate of one pose of sensor s over scene borrowed scratch
- * for the projected scan (the arena's peak grew by each thread's share) */
+ * for the projected scan (the arena's peak grew by each thread's share);
+ * the peak is a high-water mark, so ctx must not have reached it before */
 static int took_raster(rc_context *ctx, rc_scene *scene, rc_sensor *s)
 {
     rc_memory_stats before = rc_memory_stats_default(), after = rc_memory_stats_default();
     const rc_pose pose = rct_pose_ypr(0.5f, 0.3f, 1.0f, 0.4, 0.1, 0.0);
+    const uint64_t need = ctx->thread_count * rc__raster_scratch_bytes(s->rays);
     rct_buffers b;
     rct_buffers_alloc(&b, s->rays, RC_ATTR_RANGES);
     RCT_OK(ctx, rc_context_get_memory_stats(ctx, &before));
+    assert_true(before.arena_peak < before.arena_used + need);
     RCT_OK(ctx, rc_simulate(ctx, scene, s, &pose, 1u, &b.res));
     RCT_OK(ctx, rc_context_get_memory_stats(ctx, &after));
     rct_buffers_free(&b);
-    return after.arena_peak >= before.arena_used + ctx->thread_count * rc__raster_scratch_bytes(s->rays);
+    return after.arena_peak >= before.arena_used + need;
+}
+
+enum { MAP_COMMITTED, MAP_STRETCHED, MAP_STRETCHED_BACK, MAP_BAKED };
+
+/* took_raster on a fresh context: mesh as a referenced scene, seen by
+ * sensor 0 a VLP-16, 1 a cylindrical one, 2 a camera. MAP_STRETCHED: one
+ * vertex then moved out to 3 times its distance from the origin and the mesh
+ * refit (rc_scene_update_mesh, commit); MAP_STRETCHED_BACK: then put back
+ * and refit again; MAP_BAKED: the scene baked and the blob loaded. fraction
+ * > 0 sets the context's raster_edge_fraction. */
+static int raster_choice(rcu_mesh *mesh, int sensor, int how, double fraction)
+{
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_scene *scene = rct_scene_mesh(ctx, mesh, RC_MESH_REFERENCE), *use = scene;
+    rc_sensor *s = NULL;
+    float *v = mesh->vertices + 3u * (mesh->vertex_count / 2u);
+    const float keep[3] = {v[0], v[1], v[2]};
+    void *blob = NULL;
+    int took;
+    if (fraction > 0.0) ctx->raster_edge_fraction = fraction;
+    if (how == MAP_STRETCHED || how == MAP_STRETCHED_BACK) {
+        v[0] *= 3.0f;
+        v[1] *= 3.0f;
+        v[2] *= 3.0f;
+        RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+        RCT_OK(ctx, rc_scene_commit(scene));
+    }
+    if (how == MAP_STRETCHED_BACK) {
+        memcpy(v, keep, sizeof keep);
+        RCT_OK(ctx, rc_scene_update_mesh(scene, 0));
+        RCT_OK(ctx, rc_scene_commit(scene));
+    }
+    if (how == MAP_BAKED) {
+        size_t bytes = 0;
+        RCT_OK(ctx, rc_scene_bake(scene, NULL, 0, &bytes));
+        blob = malloc(bytes);
+        assert_non_null(blob);
+        RCT_OK(ctx, rc_scene_bake(scene, blob, bytes, &bytes));
+        RCT_OK(ctx, rc_scene_load_baked(ctx, blob, bytes, 0, &use));
+    }
+    if (sensor == 0)
+        RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &s));
+    else if (sensor == 1)
+        s = cyl_sensor(ctx, &cyls[0], 0.5f, 130.0f, NULL);
+    else
+        s = cam_sensor(ctx, &cams[0], 0.8f, 4.0f, NULL);
+    took = took_raster(ctx, use, s);
+    memcpy(v, keep, sizeof keep);
+    rc_sensor_destroy(s);
+    if (use != scene) rc_scene_destroy(use);
+    rc_scene_destroy(scene);
+    rc_context_destroy(ctx);
+    free(blob);
+    return took;
 }
 
 /* A spinning sensor's projected scan tests each triangle against its whole
@@ -734,37 +791,30 @@ static int took_raster(rc_context *ctx, rc_scene *scene, rc_sensor *s)
  * (a VLP-16 in the demo warehouse ran at a fifth of Embree's speed so).
  * Such a map takes the packets; a camera still takes the projected scan
  * (it clips triangles to its view), as does a map of small triangles, and
- * the room too when the context's fraction allows it. */
+ * the room too when the context's fraction allows it. The longest edge is
+ * found at commit, so a refit and a baked map's load must find it too. */
 static void test_large_triangles(void **state)
 {
     const float lo[3] = {-3.0f, -2.0f, -0.2f}, hi[3] = {4.0f, 3.0f, 2.5f};
     rcu_mesh room, ball;
     rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
-    rc_scene *room_scene, *ball_scene;
-    rc_sensor *vlp, *cyl, *cam;
     (void)state;
+    assert_true(ctx->raster_edge_fraction > 0.0 && ctx->raster_edge_fraction < 0.5);
+    rc_context_destroy(ctx);
     assert_int_equal(rcu_mesh_box(lo, hi, &room), 0);
     /* 32 x 16 segments: edges of at most 2.3 m against a diagonal of 28 m */
     assert_int_equal(rcu_mesh_uv_sphere(8.0f, 32u, 16u, &ball), 0);
-    room_scene = rct_scene_mesh(ctx, &room, RC_MESH_REFERENCE);
-    ball_scene = rct_scene_mesh(ctx, &ball, RC_MESH_REFERENCE);
-    RCT_OK(ctx, rc_sensor_create_preset(ctx, RC_PRESET_VELODYNE_VLP16, &vlp));
-    cyl = cyl_sensor(ctx, &cyls[0], 0.5f, 130.0f, NULL);
-    cam = cam_sensor(ctx, &cams[0], 0.8f, 4.0f, NULL);
-    assert_true(ctx->raster_edge_fraction > 0.0 && ctx->raster_edge_fraction < 0.5);
-    assert_false(took_raster(ctx, room_scene, vlp));
-    assert_false(took_raster(ctx, room_scene, cyl));
-    assert_true(took_raster(ctx, room_scene, cam));
-    assert_true(took_raster(ctx, ball_scene, vlp));
-    assert_true(took_raster(ctx, ball_scene, cyl));
-    ctx->raster_edge_fraction = 1.0;
-    assert_true(took_raster(ctx, room_scene, vlp));
-    rc_sensor_destroy(vlp);
-    rc_sensor_destroy(cyl);
-    rc_sensor_destroy(cam);
-    rc_scene_destroy(room_scene);
-    rc_scene_destroy(ball_scene);
-    rc_context_destroy(ctx);
+    assert_false(raster_choice(&room, 0, MAP_COMMITTED, 0.0));
+    assert_false(raster_choice(&room, 1, MAP_COMMITTED, 0.0));
+    assert_true(raster_choice(&room, 2, MAP_COMMITTED, 0.0));
+    assert_true(raster_choice(&ball, 0, MAP_COMMITTED, 0.0));
+    assert_true(raster_choice(&ball, 1, MAP_COMMITTED, 0.0));
+    assert_true(raster_choice(&room, 0, MAP_COMMITTED, 1.0));
+    /* a vertex of the ball stretched out: edges of 16 m against 39 */
+    assert_false(raster_choice(&ball, 0, MAP_STRETCHED, 0.0));
+    assert_true(raster_choice(&ball, 0, MAP_STRETCHED_BACK, 0.0));
+    assert_false(raster_choice(&room, 0, MAP_BAKED, 0.0));
+    assert_true(raster_choice(&ball, 0, MAP_BAKED, 0.0));
     rcu_mesh_free(&room);
     rcu_mesh_free(&ball);
 }

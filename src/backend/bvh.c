@@ -454,35 +454,32 @@ int rc__raster_grid_of(const rc_sensor *s, rc__raster_grid *g)
  * traced 335 scans/s so, Embree 1,700, and in an empty 12 x 12 x 3 m box
  * (12 triangles) 444, Embree 1,052. Such maps take the packets: 1 when no
  * triangle's edge is longer than this fraction of the meshes' bounding box
- * diagonal (the 1k sphere's longest, 5.4 m of 69 m, passes). A pass over
- * the triangles, at most one a ray, a call. (A camera's scan clips each
- * triangle to its view and pays no such cost.) */
+ * diagonal (the 1k sphere's longest, 5.4 m of 69 m, passes). The longest
+ * edge is found at commit (rc__mesh.longest_edge): a pass a call cost 8-13%
+ * of a one-pose call on the 10k sphere (session 42). (A camera's scan clips
+ * each triangle to its view and pays no such cost.) */
 #define RC__RASTER_EDGE_FRACTION 0.1
 static int raster_triangles_small(const sim_run *run, double fraction)
 {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY}, edge2 = 0.0, diag2 = 0.0;
-    uint32_t g, t, c, k;
+    double edge = 0.0, diag2 = 0.0;
+    rc__aabb all, b;
+    uint32_t g, k;
+    for (k = 0; k < 3; ++k) {
+        all.min[k] = INFINITY;
+        all.max[k] = -INFINITY;
+    }
     for (g = 0; g < run->raster_mesh_count; ++g) {
         const rc__mesh *mesh = run->raster_meshes[g];
-        for (t = 0; t < mesh->bvh.item_count; ++t) {
-            const float *v[3];
-            for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)mesh->leaf_tris[3u * t + c] * mesh->stride;
-            for (c = 0; c < 3; ++c) {
-                const float *a = v[c], *b = v[(c + 1u) % 3u];
-                double e2 = 0.0;
-                for (k = 0; k < 3; ++k) {
-                    const double d = (double)a[k] - (double)b[k];
-                    e2 += d * d;
-                    lo[k] = a[k] < lo[k] ? a[k] : lo[k];
-                    hi[k] = a[k] > hi[k] ? a[k] : hi[k];
-                }
-                edge2 = e2 > edge2 ? e2 : edge2;
-            }
+        edge = mesh->longest_edge > edge ? mesh->longest_edge : edge;
+        rc__wide_bounds(mesh->wide, mesh->wide_count, &b);
+        for (k = 0; k < 3; ++k) {
+            all.min[k] = b.min[k] < all.min[k] ? b.min[k] : all.min[k];
+            all.max[k] = b.max[k] > all.max[k] ? b.max[k] : all.max[k];
         }
     }
     for (k = 0; k < 3; ++k)
-        if (hi[k] >= lo[k]) diag2 += (hi[k] - lo[k]) * (hi[k] - lo[k]);
-    return edge2 <= fraction * fraction * diag2;
+        if (all.max[k] >= all.min[k]) diag2 += ((double)all.max[k] - all.min[k]) * ((double)all.max[k] - all.min[k]);
+    return edge * edge <= fraction * fraction * diag2;
 }
 
 /* Sets up a projected scan when it pays: a spherical, cylindrical or

@@ -15,7 +15,10 @@ typedef struct rc__mesh {
     uint32_t stride;           /* floats between vertices (>= 3) */
     uint32_t vertex_count;
     uint32_t triangle_count;
-    uint32_t reserved0;
+    /* The longest edge of a triangle in leaf_tris (folded flats count 0),
+     * set at commit where projected scans are built (rc__raster_longest_edge)
+     * for a spinning sensor's choice of them; 0 elsewhere. */
+    float longest_edge;
     rc__bvh bvh;               /* items are triangle indices */
     /* The triangles' vertex indices again, in leaf order (3 per bvh.refs
      * slot), so a leaf's triangles are one contiguous read instead of one

@@ -1028,6 +1028,27 @@ void rc__raster_hits(const rc__mesh *const *meshes, uint32_t mesh_count, uint32_
 #endif
     hits_run(meshes, mesh_count, world, dirs, &rr, first, n, hits, found, td);
 }
+
+float rc__raster_longest_edge(const rc__mesh *mesh)
+{
+    double longest2 = 0.0;
+    uint32_t t, c, k;
+    if (!mesh->leaf_tris) return 0.0f;
+    for (t = 0; t < mesh->bvh.item_count; ++t) {
+        const float *v[3];
+        for (c = 0; c < 3; ++c) v[c] = mesh->vertices + (size_t)mesh->leaf_tris[3u * t + c] * mesh->stride;
+        for (c = 0; c < 3; ++c) {
+            const float *a = v[c], *b = v[(c + 1u) % 3u];
+            double e2 = 0.0;
+            for (k = 0; k < 3; ++k) {
+                const double d = (double)a[k] - (double)b[k];
+                e2 += d * d;
+            }
+            longest2 = e2 > longest2 ? e2 : longest2;
+        }
+    }
+    return (float)sqrt(longest2);
+}
 #else
 typedef int rc__scan_raster_left_out; /* ISO C: no empty translation unit */
 #endif

@@ -63,6 +63,13 @@ void rc__raster_band(const rc__raster_grid *g, uint32_t row0, uint32_t rows, rc_
  * fx and fy positive. */
 int rc__raster_grid_ok(const rc__raster_grid *g);
 
+/* The longest edge of mesh's triangles as its leaf_tris give them (0 for
+ * none), for rc__mesh.longest_edge: a triangle long against the map makes a
+ * spinning sensor's projected scan test every ray of the rows its cone
+ * covers, so such maps take the packets (src/backend/bvh.c). One pass at
+ * commit, so that a call does not pay it. */
+float rc__raster_longest_edge(const rc__mesh *mesh);
+
 /* Scratch bytes rc__raster_scan needs for a scan of `rays` rays (16-byte
  * multiples). */
 size_t rc__raster_scratch_bytes(uint32_t rays);

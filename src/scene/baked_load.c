@@ -16,6 +16,7 @@
  * Traversal stacks still drop entries past their size instead of
  * overflowing (wide_trace.c, packet.c). */
 #include "bvh/intersect.h"
+#include "bvh/scan_raster.h"
 #include "scene/baked_format.h"
 #include "scene/scene.h"
 
@@ -303,6 +304,9 @@ rc_status rc__scene_load_baked(rc_context *ctx, const unsigned char *blob, size_
             m->wide = (const rc__wnode *)(const void *)(blob + r.off_nodes);
             m->wide_count = r.nodes;
             m->flats_folded = flats_folded(&r, m->vertices, m->leaf_tris);
+#if defined(RC__PROJECTED_SCANS)
+            m->longest_edge = rc__raster_longest_edge(m);
+#endif
             geo->baked = 1;
             geo->dirty = 0;
         } else {

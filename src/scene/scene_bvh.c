@@ -9,6 +9,7 @@
  *     collapse did not use once all meshes are built, so the peak (what the
  *     size query returns) depends on the counts alone while the bytes kept
  *     are the ones used. */
+#include "bvh/scan_raster.h"
 #include "scene/scene.h"
 
 #include <string.h>
@@ -241,6 +242,9 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
             if (wide) {
                 mesh->wide = wnodes + wide_off;
                 mesh->wide_count = rc__wide_collapse(&mesh->bvh, wnodes + wide_off);
+#if defined(RC__PROJECTED_SCANS)
+                mesh->longest_edge = rc__raster_longest_edge(mesh);
+#endif
                 /* the binary nodes were scratch: only refs stay */
                 mesh->bvh.nodes = NULL;
                 mesh->bvh.node_count = 0;
@@ -256,6 +260,9 @@ static rc_status build(rc_scene *scene, int wide, rc_progress_fn progress, void 
                 rc__bvh_refit(&mesh->bvh, item_bounds);
             }
             rc__mesh_fold_flats(mesh, lt); /* flats_folded stays 1, from the build */
+#if defined(RC__PROJECTED_SCANS)
+            if (wide) mesh->longest_edge = rc__raster_longest_edge(mesh);
+#endif
         }
         geo->dirty = 0;
         node_off += n + (n & 1u); /* the next mesh starts at an even index */
