@@ -11,6 +11,9 @@
 #if defined(RC__HIT_DISTANCES_SSE2) && defined(RC__LEAF4_PAIR_AVX2)
 #include <immintrin.h>
 #endif
+#if defined(RC__PACKET_MESHES) && defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 /* Slab test against a top-level node. Top-level boxes are few, so this is not
  * the hot loop; NaN from 0 * inf is avoided by the ordered min/max below. */
@@ -93,9 +96,79 @@ int rc__scene_intersect_items(const rc_scene *scene, const rc__ray *ray, rc__hit
 
 #if defined(RC__PACKET_MESHES)
 /* A packet through a scene of many meshes (rc__scene_intersect_packet): the
- * top-level tree walked once for the whole packet. */
-/* What a packet's rays span, for the top-level walk: per axis the range of
- * their origins and of their inverse directions, and the farthest hit so far. */
+ * top-level tree walked once for the whole packet.
+ * packet_span: what a packet's rays span, per axis the range of their
+ * origins and of their inverse directions, and the farthest hit so far.
+ * packet_span_box_hit: 0 only when no ray of the span can pass box_hit
+ * against the box: each ray's slab distances lie between the extremes of
+ * the interval products (float rounding is monotone, so this holds for the
+ * rounded values box_hit computes too). An axis whose inverse directions
+ * change sign, or whose products are undefined (0 * inf), constrains
+ * nothing. */
+#if defined(__SSE2__)
+/* Four lanes wide (x, y, z and one unused), the same products and
+ * comparisons as the plain C below, so the same answers: the walk and its
+ * spans were 16.6% of a VLP-16's instructions among 65 meshes, 6.8% so
+ * (session 42). The fourth lane loads the float after each triple (a ray's
+ * dir[0] or kx, a node's index or count) and is never used. */
+typedef struct packet_span {
+    __m128 org_lo, org_hi, inv_lo, inv_hi;
+    __m128 free_axes; /* all ones on an axis that constrains nothing, and lane 3 */
+    float tmax;
+} packet_span;
+
+static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits, packet_span *s)
+{
+    const __m128 zero = _mm_setzero_ps();
+    __m128 olo = _mm_loadu_ps(rays[0].org), ohi = olo, ilo = _mm_loadu_ps(rays[0].inv_dir), ihi = ilo;
+    float tmax = hits[0].t;
+    uint32_t i;
+    for (i = 1; i < n; ++i) {
+        const __m128 o = _mm_loadu_ps(rays[i].org), v = _mm_loadu_ps(rays[i].inv_dir);
+        olo = _mm_min_ps(olo, o);
+        ohi = _mm_max_ps(ohi, o);
+        ilo = _mm_min_ps(ilo, v);
+        ihi = _mm_max_ps(ihi, v);
+        if (hits[i].t > tmax) tmax = hits[i].t;
+    }
+    s->org_lo = olo;
+    s->org_hi = ohi;
+    s->inv_lo = ilo;
+    s->inv_hi = ihi;
+    /* inverse directions of both signs on an axis: it constrains nothing */
+    s->free_axes = _mm_or_ps(_mm_andnot_ps(_mm_or_ps(_mm_cmpge_ps(ilo, zero), _mm_cmple_ps(ihi, zero)),
+                                           _mm_castsi128_ps(_mm_set1_epi32(-1))),
+                             _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)));
+    s->tmax = tmax;
+}
+
+static int packet_span_box_hit(const packet_span *s, const float bmin[3], const float bmax[3])
+{
+    const __m128 lo_b = _mm_loadu_ps(bmin), hi_b = _mm_loadu_ps(bmax);
+    const __m128 d0 = _mm_sub_ps(lo_b, s->org_hi), d1 = _mm_sub_ps(lo_b, s->org_lo);
+    const __m128 d2 = _mm_sub_ps(hi_b, s->org_hi), d3 = _mm_sub_ps(hi_b, s->org_lo);
+    const __m128 p0 = _mm_mul_ps(d0, s->inv_lo), p1 = _mm_mul_ps(d0, s->inv_hi);
+    const __m128 p2 = _mm_mul_ps(d1, s->inv_lo), p3 = _mm_mul_ps(d1, s->inv_hi);
+    const __m128 p4 = _mm_mul_ps(d2, s->inv_lo), p5 = _mm_mul_ps(d2, s->inv_hi);
+    const __m128 p6 = _mm_mul_ps(d3, s->inv_lo), p7 = _mm_mul_ps(d3, s->inv_hi);
+    /* 0 * inf met on an axis: it constrains nothing */
+    const __m128 skip = _mm_or_ps(_mm_or_ps(s->free_axes, _mm_or_ps(_mm_cmpunord_ps(p0, p1), _mm_cmpunord_ps(p2, p3))),
+                                  _mm_or_ps(_mm_cmpunord_ps(p4, p5), _mm_cmpunord_ps(p6, p7)));
+    const __m128 inf = _mm_set1_ps(INFINITY);
+    __m128 lo = _mm_min_ps(_mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p2, p3)), _mm_min_ps(_mm_min_ps(p4, p5), _mm_min_ps(p6, p7)));
+    __m128 hi = _mm_max_ps(_mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p2, p3)), _mm_max_ps(_mm_max_ps(p4, p5), _mm_max_ps(p6, p7)));
+    lo = _mm_or_ps(_mm_andnot_ps(skip, lo), _mm_and_ps(skip, _mm_sub_ps(_mm_setzero_ps(), inf)));
+    hi = _mm_or_ps(_mm_andnot_ps(skip, hi), _mm_and_ps(skip, inf));
+    lo = _mm_max_ps(lo, _mm_movehl_ps(lo, lo));
+    lo = _mm_max_ss(lo, _mm_shuffle_ps(lo, lo, 1));
+    hi = _mm_min_ps(hi, _mm_movehl_ps(hi, hi));
+    hi = _mm_min_ss(hi, _mm_shuffle_ps(hi, hi, 1));
+    {
+        const float t0 = _mm_cvtss_f32(lo), t1 = _mm_cvtss_f32(hi);
+        return (t0 > 0.0f ? t0 : 0.0f) <= (t1 < s->tmax ? t1 : s->tmax) * RC__SLAB_FAR_SCALE;
+    }
+}
+#else
 typedef struct packet_span {
     float org_lo[3], org_hi[3], inv_lo[3], inv_hi[3], tmax;
 } packet_span;
@@ -120,11 +193,6 @@ static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits,
     }
 }
 
-/* 0 only when no ray of the span can pass box_hit against the box: each
- * ray's slab distances lie between the extremes of the interval products
- * (float rounding is monotone, so this holds for the rounded values box_hit
- * computes too). An axis whose inverse directions change sign, or whose
- * products are undefined (0 * inf), constrains nothing. */
 static int packet_span_box_hit(const packet_span *s, const float bmin[3], const float bmax[3])
 {
     float t0 = 0.0f, t1 = s->tmax;
@@ -150,6 +218,7 @@ static int packet_span_box_hit(const packet_span *s, const float bmin[3], const 
     }
     return t0 <= t1 * RC__SLAB_FAR_SCALE;
 }
+#endif
 
 void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
                                 int *found, uint32_t flags)
