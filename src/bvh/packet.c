@@ -476,33 +476,61 @@ static int octant_of(const rc__ray *r)
     return (r->inv_dir[0] < 0.0f) | (r->inv_dir[1] < 0.0f) << 1 | (r->inv_dir[2] < 0.0f) << 2;
 }
 
-/* A tile that straddles an axis plane: one packet per octant present (a ray
- * alone goes through the single-ray traversal). */
-static void split_by_octant(const rc__mesh *mesh, const rc__ray *rays, uint32_t n, uint32_t geom, uint32_t inst,
-                            rc__hit *hits, int *found, uint32_t flags)
+/* The next part of a tile that straddles an axis plane: its rays not yet in
+ * *done that share the first such ray's octant, copied to sub (hits to
+ * sub_hits, found cleared, their places in idx) and added to *done.
+ * Returns their count. */
+static uint32_t octant_part(const rc__ray *rays, const rc__hit *hits, uint32_t n, uint32_t *done, rc__ray *sub,
+                            rc__hit *sub_hits, int *sub_found, uint32_t *idx)
 {
-    uint32_t done = 0, i;
+    uint32_t i, m = 0;
+    int oct = -1;
+    for (i = 0; i < n; ++i) {
+        if ((*done >> i) & 1u) continue;
+        if (oct < 0) oct = octant_of(&rays[i]);
+        if (octant_of(&rays[i]) != oct) continue;
+        idx[m] = i;
+        sub[m] = rays[i];
+        sub_hits[m] = hits[i];
+        sub_found[m] = 0;
+        ++m;
+        *done |= 1u << i;
+    }
+    return m;
+}
+
+#if defined(RC__PACKET_MESHES)
+static void packet_meshes(const rc__mesh *const *meshes, const uint32_t *geoms, uint32_t count, const rc__ray *rays,
+                          uint32_t n, uint32_t inst, rc__hit *hits, int *found, uint32_t flags, int split);
+#endif
+
+/* A tile that straddles an axis plane, through meshes[0 .. count): one
+ * packet per octant present (a ray alone goes through the single-ray
+ * traversal), through all of them (mesh by mesh, each mesh would split the
+ * tile again: a sixth of a VLP-16's instructions among 65 meshes went
+ * there, session 42). */
+static void split_by_octant(const rc__mesh *const *meshes, const uint32_t *geoms, uint32_t count,
+                            const rc__ray *rays, uint32_t n, uint32_t inst, rc__hit *hits, int *found, uint32_t flags)
+{
+    uint32_t done = 0, i, j;
     while (done != (n >= 32u ? 0xFFFFFFFFu : (1u << n) - 1u)) {
         rc__ray sub[LANES];
         rc__hit sub_hits[LANES];
         int sub_found[LANES];
-        uint32_t idx[LANES], m = 0;
-        int oct = -1;
-        for (i = 0; i < n; ++i) {
-            if ((done >> i) & 1u) continue;
-            if (oct < 0) oct = octant_of(&rays[i]);
-            if (octant_of(&rays[i]) != oct) continue;
-            idx[m] = i;
-            sub[m] = rays[i];
-            sub_hits[m] = hits[i];
-            sub_found[m] = 0;
-            ++m;
-            done |= 1u << i;
-        }
+        uint32_t idx[LANES];
+        const uint32_t m = octant_part(rays, hits, n, &done, sub, sub_hits, sub_found, idx);
         if (m == 1) {
-            sub_found[0] = rc__mesh_intersect(mesh, &sub[0], geom, inst, &sub_hits[0]);
+            for (j = 0; j < count; ++j)
+                sub_found[0] |= rc__mesh_intersect(meshes[j], &sub[0], geoms[j], inst, &sub_hits[0]);
         } else {
-            RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, sub, m, geom, inst, sub_hits, sub_found, flags);
+#if defined(RC__PACKET_MESHES)
+            if (count > 1u)
+                packet_meshes(meshes, geoms, count, sub, m, inst, sub_hits, sub_found, flags, 0);
+            else
+#endif
+                for (j = 0; j < count; ++j)
+                    RC__PACKET_FN(rc__mesh_intersect_packet)(meshes[j], sub, m, geoms[j], inst, sub_hits, sub_found,
+                                                             flags);
         }
         for (i = 0; i < m; ++i) {
             hits[idx[i]] = sub_hits[i];
@@ -990,7 +1018,7 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
     }
     if (mesh->wide_count == 0) return;
     if (!trav_init(&T, mesh, rays, n, hits, found, flags)) {
-        split_by_octant(mesh, rays, n, geom, inst, hits, found, flags);
+        split_by_octant(&mesh, &geom, 1u, rays, n, inst, hits, found, flags);
         return;
     }
     while (trav_step(&T, mesh, geom, inst, 0)) {
@@ -998,9 +1026,10 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
 }
 
 #if defined(RC__PACKET_MESHES)
-void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *meshes, const uint32_t *geoms,
-                                                     uint32_t count, const rc__ray *rays, uint32_t n, uint32_t inst,
-                                                     rc__hit *hits, int *found, uint32_t flags)
+/* rc__mesh_intersect_packet_meshes; split 0: a part split_by_octant made
+ * (one octant), which is never split again here */
+static void packet_meshes(const rc__mesh *const *meshes, const uint32_t *geoms, uint32_t count, const rc__ray *rays,
+                          uint32_t n, uint32_t inst, rc__hit *hits, int *found, uint32_t flags, int split)
 {
     packet_trav T;
     uint32_t m = 0;
@@ -1013,8 +1042,14 @@ void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *mesh
                 continue;
             }
             if (!filled) {
-                /* mixed octants: every mesh the usual way below */
-                if (!trav_init(&T, mesh, rays, n, hits, found, flags)) break;
+                if (!trav_init(&T, mesh, rays, n, hits, found, flags)) {
+                    /* mixed octants: one packet an octant, through the rest */
+                    if (split) {
+                        split_by_octant(meshes + m, geoms + m, count - m, rays, n, inst, hits, found, flags);
+                        return;
+                    }
+                    break;
+                }
                 filled = 1;
             } else {
                 /* the lanes stay filled (their tmax the hits' so far, P.tmax
@@ -1027,6 +1062,13 @@ void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *mesh
             }
         }
     for (; m < count; ++m) RC__PACKET_FN(rc__mesh_intersect_packet)(meshes[m], rays, n, geoms[m], inst, hits, found, flags);
+}
+
+void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *meshes, const uint32_t *geoms,
+                                                     uint32_t count, const rc__ray *rays, uint32_t n, uint32_t inst,
+                                                     rc__hit *hits, int *found, uint32_t flags)
+{
+    packet_meshes(meshes, geoms, count, rays, n, inst, hits, found, flags, 1);
 }
 #endif
 
