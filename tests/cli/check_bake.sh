@@ -40,6 +40,24 @@ run 0 "" "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 -
 grep -Eq '"mesh":"copy"[,}]' out.txt || { cat out.txt; fail "bench reports mesh copy"; }
 cmp ply.f32 copy.f32 || fail "a copied map changed the ranges"
 run 2 "--mesh: expected reference or copy, got 'flash'" "$RC" bench --mesh flash
+# the map cut into meshes of its own (a world of separate objects; 40 takes
+# the built-in backend's walk of the top-level tree, 5 its packets mesh by
+# mesh), referenced or copied: the same ranges, and bench says how many
+for parts in 5 40; do
+    run 0 "" "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 --meshes $parts \
+        --ranges-out parts.f32 $BACKEND
+    grep -Eq "\"ranges_consistent\":true,.*\"mesh\":\"reference\",\"meshes\":$parts}" out.txt ||
+        { cat out.txt; fail "bench reports --meshes $parts, its ranges consistent"; }
+    cmp ply.f32 parts.f32 || fail "the map as $parts meshes changed the ranges"
+done
+run 0 "" "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --threads 2 --meshes 40 --mesh copy \
+    --ranges-out parts.f32 $BACKEND
+grep -Eq '"mesh":"copy","meshes":40}' out.txt || { cat out.txt; fail "bench reports --meshes 40 --mesh copy"; }
+cmp ply.f32 parts.f32 || fail "the map as 40 copied meshes changed the ranges"
+run 2 "--meshes: expected a count >= 1, got '0'" "$RC" bench --meshes 0
+run 2 "--meshes 20000: the map has 9996 triangles" "$RC" bench --map sphere.ply --meshes 20000
+run 2 "--meshes: sphere.rcmap is a baked map, which keeps the meshes it was baked with" \
+    "$RC" bench --map sphere.rcmap --meshes 2
 run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" bench --poses-per-call 0
 # an explicit --poses-per-call is taken as given, past the 128 MiB of ranges
 # that size the default (82 D435 scans): a GPU wants 10,000 VLP-16 scans a call

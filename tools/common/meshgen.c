@@ -253,6 +253,45 @@ int rcu_mesh_append(rcu_mesh *dst, const rcu_mesh *src)
     return 0;
 }
 
+uint32_t rcu_mesh_part_first(uint32_t triangles, uint32_t parts, uint32_t k)
+{
+    return (uint32_t)((uint64_t)triangles * k / parts);
+}
+
+int rcu_mesh_split(const rcu_mesh *mesh, uint32_t parts, rcu_mesh *out)
+{
+    uint32_t *map, k, j, c;
+    if (parts == 0 || parts > mesh->triangle_count)
+        return rcu_fail("cannot cut %u triangles into %u meshes", mesh->triangle_count, parts);
+    map = (uint32_t *)malloc((size_t)(mesh->vertex_count ? mesh->vertex_count : 1) * sizeof *map);
+    if (!map) return rcu_fail("out of memory for a vertex map of %u vertices", mesh->vertex_count);
+    memset(map, 0xFF, (size_t)mesh->vertex_count * sizeof *map);
+    for (k = 0; k < parts; ++k) {
+        const uint32_t first = rcu_mesh_part_first(mesh->triangle_count, parts, k);
+        const uint32_t count = rcu_mesh_part_first(mesh->triangle_count, parts, k + 1u) - first;
+        const uint32_t *tri = mesh->indices + 3u * (size_t)first;
+        uint32_t used = 0;
+        /* the vertices this part uses, numbered as first met */
+        for (j = 0; j < 3u * count; ++j)
+            if (map[tri[j]] == UINT32_MAX) map[tri[j]] = used++;
+        if (rcu_mesh_reserve(&out[k], used, count) != 0) {
+            while (k-- > 0) rcu_mesh_free(&out[k]);
+            free(map);
+            return -1;
+        }
+        for (j = 0; j < 3u * count; ++j) {
+            const uint32_t v = map[tri[j]];
+            out[k].indices[j] = v;
+            for (c = 0; c < 3u; ++c) out[k].vertices[3u * (size_t)v + c] = mesh->vertices[3u * (size_t)tri[j] + c];
+        }
+        out[k].vertex_count = used;
+        out[k].triangle_count = count;
+        for (j = 0; j < 3u * count; ++j) map[tri[j]] = UINT32_MAX;
+    }
+    free(map);
+    return 0;
+}
+
 void rcu_mesh_transform(rcu_mesh *mesh, float yaw, const float translation[3])
 {
     double c = cos((double)yaw), s = sin((double)yaw);

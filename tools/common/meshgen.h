@@ -65,6 +65,15 @@ int rcu_mesh_wedge(const float min[3], const float max[3], rcu_mesh *out);
 /* Appends src to dst (dst may be empty/zeroed); src is unchanged. */
 int rcu_mesh_append(rcu_mesh *dst, const rcu_mesh *src);
 
+/* Cuts mesh into `parts` meshes (1 <= parts <= triangle_count) of
+ * consecutive triangles: part k holds triangles [first(k), first(k + 1)),
+ * first(k) = triangle_count * k / parts (rcu_mesh_part_first), with only the
+ * vertices they use, in the order they first use them. out holds `parts`
+ * meshes (freed with rcu_mesh_free each); on failure none is left. 0 or -1
+ * with rcu_last_error(). */
+int rcu_mesh_split(const rcu_mesh *mesh, uint32_t parts, rcu_mesh *out);
+uint32_t rcu_mesh_part_first(uint32_t triangles, uint32_t parts, uint32_t k);
+
 /* Moves every vertex: rotate about z by yaw (radians), then translate. */
 void rcu_mesh_transform(rcu_mesh *mesh, float yaw, const float translation[3]);
 

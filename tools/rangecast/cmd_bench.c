@@ -60,6 +60,8 @@ static void usage(FILE *f)
         "                     (Embree's build; the built-in backend has one build)\n"
         "  --mesh M           reference (default): the map's arrays used in place; copy: copied\n"
         "                     into the arena (RC_MESH_COPY; bytes_per_triangle then counts the copy)\n"
+        "  --meshes N         the map cut into N meshes of consecutive triangles, each a geometry\n"
+        "                     with its own vertices, as a world of separate objects (default 1)\n"
         "  --threads N        worker threads, 0 = all CPUs (default)\n"
         "  --repeat K         timed repeats of the whole pose set; the median counts (default 3)\n"
         "  --triangles N      sphere size without --map: 1k, 10k, 100k, 1M (default), 10M, ...\n"
@@ -74,7 +76,8 @@ static void usage(FILE *f)
         "build_s scans_per_s rays_per_s repeat_s peak_rss_bytes arena_bytes scene_bytes\n"
         "bytes_per_triangle backend_bytes device_bytes total_bytes_per_triangle hit_fraction\n"
         "range_err_mean_m range_err_p999_m range_err_max_m hit_mismatch ranges_consistent\n"
-        "build_quality baked_map_bytes vulkan_traversal poses_per_call results_on_device mesh.\n"
+        "build_quality baked_map_bytes vulkan_traversal poses_per_call results_on_device mesh\n"
+        "meshes.\n"
         "bytes_per_triangle: the committed scene's arena bytes (rc_scene_get_info) per\n"
         "triangle; total_bytes_per_triangle adds what Embree/Vulkan hold outside the arena.\n"
         "A baked map (.rcmap, rangecast bake) is loaded in place: build_s is then the load\n"
@@ -88,6 +91,19 @@ static void usage(FILE *f)
         "hit_mismatch (sphere only, else null): rays the closed sphere must return\n"
         "within [range_min, range_max] that come back without a hit, or vice versa.\n"
         "peak_rss_bytes is taken after the timed loop, before the accuracy pass.\n");
+}
+
+/* The map's triangle that a hit on geometry geom, triangle prim names
+ * (UINT64_MAX for none): with --meshes, part geom's triangles start at
+ * rcu_mesh_part_first. */
+static uint64_t mesh_triangle(const rcu_mesh *mesh, uint32_t geom, uint32_t prim)
+{
+    uint32_t first;
+    if (rcp_mesh_parts <= 1) return rcp_mesh_triangle(mesh, geom, prim);
+    if (geom >= rcp_mesh_parts) return UINT64_MAX;
+    first = rcu_mesh_part_first(mesh->triangle_count, rcp_mesh_parts, geom);
+    if (prim >= rcu_mesh_part_first(mesh->triangle_count, rcp_mesh_parts, geom + 1u) - first) return UINT64_MAX;
+    return (uint64_t)first + prim;
 }
 
 /* JSON string (the map path) with the few escapes it can need. */
@@ -297,6 +313,10 @@ static int parse_args(int argc, char **argv, bench_args *a)
                 rcp_mesh_flags = RC_MESH_COPY;
             else
                 return rcp_usage_error(cmd, "--mesh: expected reference or copy, got '%s'", v), -1;
+        } else if (OPT("--meshes")) {
+            if (r < 0) return -1;
+            if (rcp_parse_u32(v, &rcp_mesh_parts) != 0 || rcp_mesh_parts == 0)
+                return rcp_usage_error(cmd, "--meshes: expected a count >= 1, got '%s'", v), -1;
         } else if (OPT("--build-quality")) {
             if (r < 0) return -1;
             if (rcp_parse_build_quality(cmd, v, &rcp_build_quality) != 0) return -1;
@@ -340,6 +360,9 @@ static int parse_args(int argc, char **argv, bench_args *a)
         fprintf(stderr, "rangecast bench: note: --pose-count and --seed are ignored with --poses\n");
     if (a->on_device && a->backend != RC_BACKEND_VULKAN)
         return rcp_usage_error(cmd, "--results-on-device needs --backend vulkan"), -1;
+    if (a->embree_single && rcp_mesh_parts > 1)
+        return rcp_usage_error(cmd, "--meshes needs rc_simulate: not with --backend embree-single (one geometry)"),
+               -1;
     if (a->embree_single && a->set_poses_per_call)
         fprintf(stderr, "rangecast bench: note: --poses-per-call is ignored with --backend embree-single "
                         "(its loop makes no rc_simulate calls)\n");
@@ -439,6 +462,16 @@ int rcp_cmd_bench(int argc, char **argv)
             return rcp_fail(cmd, "%s", rcu_last_error());
     } else if (rcp_mesh_load(a.map, &mesh) != 0) {
         return rcp_fail(cmd, "%s", rcu_last_error());
+    }
+    if (rcp_mesh_parts > 1 && rcp_baked_of(&mesh)) {
+        rcp_usage_error(cmd, "--meshes: %s is a baked map, which keeps the meshes it was baked with", a.map);
+        rc = RCP_EXIT_USAGE;
+        goto done;
+    }
+    if (rcp_mesh_parts > mesh.triangle_count) {
+        rcp_usage_error(cmd, "--meshes %u: the map has %u triangles", rcp_mesh_parts, mesh.triangle_count);
+        rc = RCP_EXIT_USAGE;
+        goto done;
     }
 
     if (a.ouster_path && rcp_ouster_load(a.ouster_path, &ondn) != 0) {
@@ -638,7 +671,7 @@ int rcp_cmd_bench(int argc, char **argv)
                     }
                     if (hit) {
                         acc.hits++;
-                        const uint64_t tri = rcp_mesh_triangle(&mesh, gg[r], pp[r]);
+                        const uint64_t tri = mesh_triangle(&mesh, gg[r], pp[r]);
                         if (tri >= mesh.triangle_count) {
                             acc.bad_prims++;
                         } else {
@@ -749,8 +782,9 @@ int rcp_cmd_bench(int argc, char **argv)
                    (rcp_context_flags & RC_CONTEXT_VULKAN_RAY_QUERY) ? "ray-query" : "compute");
         else
             printf(",\"vulkan_traversal\":null");
-        printf(",\"poses_per_call\":%u,\"results_on_device\":%s,\"mesh\":\"%s\"}\n", batch,
-               a.on_device ? "true" : "false", rcp_mesh_flags == RC_MESH_COPY ? "copy" : "reference");
+        printf(",\"poses_per_call\":%u,\"results_on_device\":%s,\"mesh\":\"%s\",\"meshes\":%u}\n", batch,
+               a.on_device ? "true" : "false", rcp_mesh_flags == RC_MESH_COPY ? "copy" : "reference",
+               rcp_mesh_parts);
         fflush(stdout);
     }
     rc = RCP_EXIT_OK;

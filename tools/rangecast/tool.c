@@ -227,6 +227,7 @@ const char *rcp_build_quality_name(uint32_t quality)
 
 uint32_t rcp_build_quality = RC_BUILD_BALANCED;
 uint32_t rcp_mesh_flags = RC_MESH_REFERENCE;
+uint32_t rcp_mesh_parts = 1;
 
 static const char *const sensor_names[] = {"vlp16",       "vlp16-360", "os1-64", "d435",
                                            "livox-mid40", "ust-10lx",  "lds-01"};
@@ -248,20 +249,25 @@ int rcp_parse_sensor(const char *cmd, const char *s, uint32_t *preset)
     return 0;
 }
 
-static rc_scene_desc scene_desc_for(const rcu_mesh *mesh)
+static rc_scene_desc scene_desc_for(const rcu_mesh *mesh, const rcu_mesh *parts, uint32_t part_count)
 {
     rc_scene_desc sd = rc_scene_desc_default();
-    sd.max_geometries = 1;
+    uint64_t vertices = mesh->vertex_count;
+    uint32_t k;
+    if (part_count > 1)
+        for (vertices = 0, k = 0; k < part_count; k++) vertices += parts[k].vertex_count;
+    sd.max_geometries = part_count > 1 ? part_count : 1;
     sd.max_triangles = mesh->triangle_count;
     /* referenced in place (the default), or room for its copy (bench --mesh copy) */
-    sd.max_vertices = rcp_mesh_flags == RC_MESH_COPY ? mesh->vertex_count : 0;
+    sd.max_vertices = rcp_mesh_flags == RC_MESH_COPY ? vertices : 0;
     sd.max_copied_triangles = rcp_mesh_flags == RC_MESH_COPY ? mesh->triangle_count : 0;
     sd.build_quality = rcp_build_quality;
     return sd;
 }
 
 int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
-                    const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes)
+                    const rcu_mesh *parts, uint32_t part_count, const uint32_t *presets, uint32_t preset_count,
+                    size_t *total, size_t *scene_bytes)
 {
     rc_context_desc cd = rc_context_desc_default();
     size_t ctx_bytes = 0, sb = 0, sum;
@@ -279,7 +285,7 @@ int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const r
          * one (one thread, an arena of just its own size) to ask it. */
         rc_context_desc pd = cd;
         rc_context *probe = NULL;
-        rc_scene_desc sd = scene_desc_for(mesh);
+        rc_scene_desc sd = scene_desc_for(mesh, parts, part_count);
         size_t probe_bytes = 0;
         pd.thread_count = 1;
         if ((st = rc_context_memory_requirements(&pd, &probe_bytes)) != RC_OK)
@@ -349,8 +355,11 @@ static int show_progress(void *user, const char *stage, double fraction)
 
 void rcp_world_destroy(rcp_world *world)
 {
+    uint32_t k;
     if (!world) return;
     rc_context_destroy(world->ctx); /* scenes and sensors go with it */
+    for (k = 0; k < world->part_count; k++) rcu_mesh_free(&world->parts[k]);
+    free(world->parts);
     memset(world, 0, sizeof *world);
 }
 
@@ -392,12 +401,28 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     const char *call;
     memset(w, 0, sizeof *w);
     if (preset_count > RCP_MAX_SENSORS) return rcp_fail(cmd, "too many sensors");
-    if (rcp_arena_bytes(cmd, backend, threads, mesh, presets, preset_count, &w->arena_bytes,
-                        &w->scene_bytes) != RCP_EXIT_OK)
+    if (mesh && rcp_mesh_parts > 1 && !rcp_baked_of(mesh)) {
+        /* bench --meshes: the map as that many meshes of its own */
+        w->parts = (rcu_mesh *)calloc(rcp_mesh_parts, sizeof *w->parts);
+        if (!w->parts) return rcp_fail(cmd, "out of memory for %u meshes", rcp_mesh_parts);
+        if (rcu_mesh_split(mesh, rcp_mesh_parts, w->parts) != 0) {
+            rcp_fail(cmd, "--meshes %u: %s", rcp_mesh_parts, rcu_last_error());
+            rcp_world_destroy(w);
+            return RCP_EXIT_FAIL;
+        }
+        w->part_count = rcp_mesh_parts;
+    }
+    if (rcp_arena_bytes(cmd, backend, threads, mesh, w->parts, w->part_count, presets, preset_count,
+                        &w->arena_bytes, &w->scene_bytes) != RCP_EXIT_OK) {
+        rcp_world_destroy(w);
         return RCP_EXIT_FAIL;
+    }
     if (rays) {
         size_t b = 0;
-        if (rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
+        if (rays_sensor_bytes(cmd, rays_model, rays, &b) != RCP_EXIT_OK) {
+            rcp_world_destroy(w);
+            return RCP_EXIT_FAIL;
+        }
         w->arena_bytes += b;
     }
     if (rcp_order_room && mesh) {
@@ -412,7 +437,10 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
     cd.thread_count = threads;
     cd.memory = NULL;             /* the library mallocs exactly this much, once */
     cd.memory_size = w->arena_bytes;
-    if (create_context(cmd, &cd, &w->ctx) != RCP_EXIT_OK) return RCP_EXIT_FAIL;
+    if (create_context(cmd, &cd, &w->ctx) != RCP_EXIT_OK) {
+        rcp_world_destroy(w);
+        return RCP_EXIT_FAIL;
+    }
     rc_context_get_backend(w->ctx, &w->backend);
     rc_context_get_thread_count(w->ctx, &w->threads);
     if (mesh && rcp_baked_of(mesh)) {
@@ -423,19 +451,22 @@ static int world_create(const char *cmd, uint32_t backend, uint32_t threads, con
         if ((st = rc_scene_load_baked(w->ctx, baked->blob, baked->bytes, 0, &w->scene)) != RC_OK) goto fail;
         w->build_s = rcu_now() - t0;
     } else if (mesh) {
-        rc_scene_desc sd = scene_desc_for(mesh);
+        rc_scene_desc sd = scene_desc_for(mesh, w->parts, w->part_count);
         rc_mesh_desc md = rc_mesh_desc_default();
-        uint32_t geom = 0;
+        uint32_t geom = 0, part;
         double t0;
-        md.flags = rcp_mesh_flags;
-        md.vertices = mesh->vertices;
-        md.vertex_count = mesh->vertex_count;
-        md.indices = mesh->indices;
-        md.triangle_count = mesh->triangle_count;
         call = "rc_scene_create";
         if ((st = rc_scene_create(w->ctx, &sd, &w->scene)) != RC_OK) goto fail;
         call = "rc_scene_add_mesh";
-        if ((st = rc_scene_add_mesh(w->scene, &md, &geom)) != RC_OK) goto fail;
+        for (part = 0; part < (w->part_count ? w->part_count : 1u); part++) {
+            const rcu_mesh *m = w->part_count ? &w->parts[part] : mesh;
+            md.flags = rcp_mesh_flags;
+            md.vertices = m->vertices;
+            md.vertex_count = m->vertex_count;
+            md.indices = m->indices;
+            md.triangle_count = m->triangle_count;
+            if ((st = rc_scene_add_mesh(w->scene, &md, &geom)) != RC_OK) goto fail;
+        }
         call = "rc_scene_commit";
         t0 = rcu_now();
         if (mesh->triangle_count >= RCP_PROGRESS_MIN_TRIANGLES && isatty(STDERR_FILENO)) {

@@ -75,6 +75,8 @@ typedef struct rcp_world {
     size_t arena_bytes;                  /* desc.memory_size we asked for */
     size_t scene_bytes;                  /* rc_scene_memory_requirements */
     double build_s;                      /* wall time of rc_scene_commit (rc_scene_load_baked for a .rcmap) */
+    rcu_mesh *parts;                     /* bench --meshes N > 1: the map's N meshes (geometries 0 .. N-1) */
+    uint32_t part_count;
 } rcp_world;
 
 /* Creates the world; on failure prints the error (as cmd) and returns
@@ -89,6 +91,10 @@ extern uint32_t rcp_build_quality;
 /* --mesh of bench: how the map's mesh is handed in, RC_MESH_REFERENCE (the
  * default: used in place) or RC_MESH_COPY (copied into the arena). */
 extern uint32_t rcp_mesh_flags;
+/* --meshes of bench: the map cut into this many meshes of consecutive
+ * triangles, each a geometry with its own vertices (rcu_mesh_split); 1 = the
+ * map as one mesh. */
+extern uint32_t rcp_mesh_parts;
 /* 1 (bench, simulate): the contexts get RC_SIMULATE_SCRATCH_PER_THREAD a
  * thread beyond the exact requirements, so that calls on maps larger than the
  * cache run ordered; 0 (info, demo): the exact figure. */
@@ -103,9 +109,11 @@ int rcp_world_create_rays(const char *cmd, uint32_t backend, uint32_t threads, c
 void rcp_world_destroy(rcp_world *world);
 
 /* Exact arena bytes of a context + one scene of this mesh on a backend
- * (threads as given), without building anything. */
+ * (threads as given), without building anything; with part_count > 1 the
+ * scene holds parts[0 .. part_count) instead (the mesh cut up). */
 int rcp_arena_bytes(const char *cmd, uint32_t backend, uint32_t threads, const rcu_mesh *mesh,
-                    const uint32_t *presets, uint32_t preset_count, size_t *total, size_t *scene_bytes);
+                    const rcu_mesh *parts, uint32_t part_count, const uint32_t *presets, uint32_t preset_count,
+                    size_t *total, size_t *scene_bytes);
 
 /* Median of v[0..n) (sorts v); NaN when n is 0. */
 double rcp_median(double *v, size_t n);
