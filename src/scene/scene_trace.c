@@ -8,6 +8,7 @@
 #include "bvh/leaf4.h" /* rc__leaf4_have_avx2 */
 
 #include <math.h>
+#include <stddef.h>
 #if defined(RC__HIT_DISTANCES_SSE2) && defined(RC__LEAF4_PAIR_AVX2)
 #include <immintrin.h>
 #endif
@@ -111,6 +112,14 @@ int rc__scene_intersect_items(const rc_scene *scene, const rc__ray *ray, rc__hit
  * spans were 16.6% of a VLP-16's instructions among 65 meshes, 6.8% so
  * (session 42). The fourth lane loads the float after each triple (a ray's
  * dir[0] or kx, a node's index or count) and is never used. */
+/* The four floats at byte `at` of the struct at p (the fourth the field
+ * after a triple), read through the struct's address rather than the
+ * triple's, whose three floats the load passes. */
+static RC__FORCE_INLINE __m128 load_after(const void *p, size_t at)
+{
+    return _mm_loadu_ps((const float *)(const void *)((const char *)p + at));
+}
+
 typedef struct packet_span {
     __m128 org_lo, org_hi, inv_lo, inv_hi;
     __m128 free_axes; /* all ones on an axis that constrains nothing, and lane 3 */
@@ -120,11 +129,13 @@ typedef struct packet_span {
 static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits, packet_span *s)
 {
     const __m128 zero = _mm_setzero_ps();
-    __m128 olo = _mm_loadu_ps(rays[0].org), ohi = olo, ilo = _mm_loadu_ps(rays[0].inv_dir), ihi = ilo;
+    __m128 olo = load_after(&rays[0], offsetof(rc__ray, org)), ohi = olo;
+    __m128 ilo = load_after(&rays[0], offsetof(rc__ray, inv_dir)), ihi = ilo;
     float tmax = hits[0].t;
     uint32_t i;
     for (i = 1; i < n; ++i) {
-        const __m128 o = _mm_loadu_ps(rays[i].org), v = _mm_loadu_ps(rays[i].inv_dir);
+        const __m128 o = load_after(&rays[i], offsetof(rc__ray, org));
+        const __m128 v = load_after(&rays[i], offsetof(rc__ray, inv_dir));
         olo = _mm_min_ps(olo, o);
         ohi = _mm_max_ps(ohi, o);
         ilo = _mm_min_ps(ilo, v);
@@ -142,9 +153,9 @@ static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits,
     s->tmax = tmax;
 }
 
-static int packet_span_box_hit(const packet_span *s, const float bmin[3], const float bmax[3])
+static int packet_span_box_hit(const packet_span *s, const rc__bvh_node *nd)
 {
-    const __m128 lo_b = _mm_loadu_ps(bmin), hi_b = _mm_loadu_ps(bmax);
+    const __m128 lo_b = load_after(nd, offsetof(rc__bvh_node, bmin)), hi_b = load_after(nd, offsetof(rc__bvh_node, bmax));
     const __m128 d0 = _mm_sub_ps(lo_b, s->org_hi), d1 = _mm_sub_ps(lo_b, s->org_lo);
     const __m128 d2 = _mm_sub_ps(hi_b, s->org_hi), d3 = _mm_sub_ps(hi_b, s->org_lo);
     const __m128 p0 = _mm_mul_ps(d0, s->inv_lo), p1 = _mm_mul_ps(d0, s->inv_hi);
@@ -193,8 +204,9 @@ static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits,
     }
 }
 
-static int packet_span_box_hit(const packet_span *s, const float bmin[3], const float bmax[3])
+static int packet_span_box_hit(const packet_span *s, const rc__bvh_node *nd)
 {
+    const float *bmin = nd->bmin, *bmax = nd->bmax;
     float t0 = 0.0f, t1 = s->tmax;
     int k;
     for (k = 0; k < 3; ++k) {
@@ -233,7 +245,7 @@ void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint
     packet_span_of(rays, n, hits, &span);
     for (;;) {
         const rc__bvh_node *nd = &top->nodes[ni];
-        if (packet_span_box_hit(&span, nd->bmin, nd->bmax)) {
+        if (packet_span_box_hit(&span, nd)) {
             if (nd->count == 0) {
                 stack[sp++] = nd->index + 1; /* depth is capped by the builder */
                 ni = nd->index;
