@@ -39,8 +39,10 @@
  * when the packets could take every mesh: the walk skips the meshes a packet
  * misses. A VLP-16 in a room of balls, each its own mesh, walk against every
  * mesh (session 42, 2 threads, two runs): 2 meshes -4 to -17%, 4 -3%,
- * 9 -1 to +1%, 12 +1 to +2.5%, 16 -1.5 to +4%, 25 +5 to +8%. */
-#define RC__PACKET_WALK_MESHES 12u
+ * 9 -1 to +1%, 12 +1 to +2.5%, 16 -1.5 to +4%, 25 +5 to +8%; with the
+ * walk's test in SSE2, instructions (callgrind): 2 meshes +3.0%, 4 +1.4%,
+ * 6 +0.3%, 7 -0.3%, 8 -0.7%, 9 -1.2%. */
+#define RC__PACKET_WALK_MESHES 8u
 /* Projected scans (scan_raster.h) for meshes of at most this many triangles
  * per ray of the scan. On the sphere against the packets (session 32, one
  * thread each, run side by side on the two cores): a VLP-16 (14,400 rays)
