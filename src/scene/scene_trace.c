@@ -124,6 +124,7 @@ typedef struct packet_span {
     __m128 org_lo, org_hi, inv_lo, inv_hi;
     __m128 free_axes; /* all ones on an axis that constrains nothing, and lane 3 */
     float tmax;
+    int one_origin; /* 1 when org_lo and org_hi are the same point */
 } packet_span;
 
 static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits, packet_span *s)
@@ -151,23 +152,30 @@ static void packet_span_of(const rc__ray *rays, uint32_t n, const rc__hit *hits,
                                            _mm_castsi128_ps(_mm_set1_epi32(-1))),
                              _mm_castsi128_ps(_mm_set_epi32(-1, 0, 0, 0)));
     s->tmax = tmax;
+    s->one_origin = (_mm_movemask_ps(_mm_cmpeq_ps(olo, ohi)) & 7) == 7;
 }
 
 static int packet_span_box_hit(const packet_span *s, const rc__bvh_node *nd)
 {
     const __m128 lo_b = load_after(nd, offsetof(rc__bvh_node, bmin)), hi_b = load_after(nd, offsetof(rc__bvh_node, bmax));
-    const __m128 d0 = _mm_sub_ps(lo_b, s->org_hi), d1 = _mm_sub_ps(lo_b, s->org_lo);
-    const __m128 d2 = _mm_sub_ps(hi_b, s->org_hi), d3 = _mm_sub_ps(hi_b, s->org_lo);
-    const __m128 p0 = _mm_mul_ps(d0, s->inv_lo), p1 = _mm_mul_ps(d0, s->inv_hi);
-    const __m128 p2 = _mm_mul_ps(d1, s->inv_lo), p3 = _mm_mul_ps(d1, s->inv_hi);
-    const __m128 p4 = _mm_mul_ps(d2, s->inv_lo), p5 = _mm_mul_ps(d2, s->inv_hi);
-    const __m128 p6 = _mm_mul_ps(d3, s->inv_lo), p7 = _mm_mul_ps(d3, s->inv_hi);
-    /* 0 * inf met on an axis: it constrains nothing */
-    const __m128 skip = _mm_or_ps(_mm_or_ps(s->free_axes, _mm_or_ps(_mm_cmpunord_ps(p0, p1), _mm_cmpunord_ps(p2, p3))),
-                                  _mm_or_ps(_mm_cmpunord_ps(p4, p5), _mm_cmpunord_ps(p6, p7)));
     const __m128 inf = _mm_set1_ps(INFINITY);
-    __m128 lo = _mm_min_ps(_mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p2, p3)), _mm_min_ps(_mm_min_ps(p4, p5), _mm_min_ps(p6, p7)));
-    __m128 hi = _mm_max_ps(_mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p2, p3)), _mm_max_ps(_mm_max_ps(p4, p5), _mm_max_ps(p6, p7)));
+    const __m128 d0 = _mm_sub_ps(lo_b, s->org_hi), d2 = _mm_sub_ps(hi_b, s->org_hi);
+    const __m128 p0 = _mm_mul_ps(d0, s->inv_lo), p1 = _mm_mul_ps(d0, s->inv_hi);
+    const __m128 p4 = _mm_mul_ps(d2, s->inv_lo), p5 = _mm_mul_ps(d2, s->inv_hi);
+    /* 0 * inf met on an axis: it constrains nothing */
+    __m128 skip = _mm_or_ps(s->free_axes, _mm_or_ps(_mm_cmpunord_ps(p0, p1), _mm_cmpunord_ps(p4, p5)));
+    __m128 lo = _mm_min_ps(_mm_min_ps(p0, p1), _mm_min_ps(p4, p5));
+    __m128 hi = _mm_max_ps(_mm_max_ps(p0, p1), _mm_max_ps(p4, p5));
+    if (!s->one_origin) {
+        /* the products from the other end of the origins' range too (with
+         * one origin they are the same values) */
+        const __m128 d1 = _mm_sub_ps(lo_b, s->org_lo), d3 = _mm_sub_ps(hi_b, s->org_lo);
+        const __m128 p2 = _mm_mul_ps(d1, s->inv_lo), p3 = _mm_mul_ps(d1, s->inv_hi);
+        const __m128 p6 = _mm_mul_ps(d3, s->inv_lo), p7 = _mm_mul_ps(d3, s->inv_hi);
+        skip = _mm_or_ps(skip, _mm_or_ps(_mm_cmpunord_ps(p2, p3), _mm_cmpunord_ps(p6, p7)));
+        lo = _mm_min_ps(lo, _mm_min_ps(_mm_min_ps(p2, p3), _mm_min_ps(p6, p7)));
+        hi = _mm_max_ps(hi, _mm_max_ps(_mm_max_ps(p2, p3), _mm_max_ps(p6, p7)));
+    }
     lo = _mm_or_ps(_mm_andnot_ps(skip, lo), _mm_and_ps(skip, _mm_sub_ps(_mm_setzero_ps(), inf)));
     hi = _mm_or_ps(_mm_andnot_ps(skip, hi), _mm_and_ps(skip, inf));
     lo = _mm_max_ps(lo, _mm_movehl_ps(lo, lo));
