@@ -765,7 +765,7 @@ static int raster_choice(rcu_mesh *mesh, int sensor, int how, double fraction)
     if (how == MAP_BAKED) {
         size_t bytes = 0;
         RCT_OK(ctx, rc_scene_bake(scene, NULL, 0, &bytes));
-        blob = malloc(bytes);
+        blob = rct_alloc16(bytes); /* (32-bit ARM's malloc gives 8-byte alignment) */
         assert_non_null(blob);
         RCT_OK(ctx, rc_scene_bake(scene, blob, bytes, &bytes));
         RCT_OK(ctx, rc_scene_load_baked(ctx, blob, bytes, 0, &use));

@@ -487,7 +487,8 @@ RC_API rc_status rc_scene_baked_memory_requirements(const rc_context *ctx, const
 
 /* Creates a committed, read-only scene from a baked map, referencing the blob
  * in place: keep it alive and unchanged until the scene is destroyed. blob
- * must be 16-byte aligned (malloc and mmap are). On the built-in backend the
+ * must be 16-byte aligned (mmap and aligned_alloc give that; malloc does on
+ * 64-bit glibc, but only 8 bytes on 32-bit ARM). On the built-in backend the
  * baked tree is used as it is, so ranges are bit-identical to those of the
  * scene that was baked; Embree and Vulkan build their own structure from the
  * blob's meshes. The scene's geometry ids are the baked scene's, its origin

@@ -43,7 +43,8 @@ static rc_status check_blob(rc_context *ctx, const void *blob, size_t bytes)
     RC_RETURN_IF(ctx, blob == NULL, RC_ERR_INVALID_ARGUMENT, "blob is NULL");
     RC_RETURN_IF(ctx, bytes == 0, RC_ERR_INVALID_ARGUMENT, "bytes is 0");
     RC_RETURN_IF(ctx, (uintptr_t)blob % 16u != 0, RC_ERR_INVALID_ARGUMENT,
-                 "blob is at %p, not on a 16-byte boundary (malloc, aligned_alloc and mmap give one)", blob);
+                 "blob is at %p, not on a 16-byte boundary (mmap and aligned_alloc give one; 32-bit malloc may not)",
+                 blob);
     return RC_OK;
 }
 
