@@ -276,6 +276,27 @@ static void packet_meshes_equal_meshwise(const packet_build *b, uint32_t flags)
  * small boxes share planes with the tiles' origins (make_tile) and the big
  * box has a copy (ties across the batches); some tiles leave the sphere and
  * the copy to the caller (skip), some start from nearer hits. */
+/* A walk's hit (found) against rc__scene_intersect_items' (want_found): the
+ * same t bit for bit, instance, geometry and prim (a pending prim settled
+ * against its own mesh's refs, and only with the flag). Returns found. */
+static int walk_hit_equal(const rc_scene *scene, const rc__hit *got, int found, const rc__hit *want, int want_found,
+                          uint32_t flags)
+{
+    rc__hit h = *got;
+    assert_int_equal(found, want_found);
+    if (!found) return 0;
+    assert_memory_equal(&h.t, &want->t, sizeof(float));
+    assert_int_equal(h.inst, want->inst);
+    assert_int_equal(h.geom, want->geom);
+    if (h.prim == RC__PRIM_PENDING) {
+        const rc_scene *owner = h.inst == RC_INVALID_ID ? scene : scene->insts[h.inst].source;
+        assert_true(flags & RC__PACKET_PRIMS_PENDING);
+        rc__hit_settle(&h, owner->geoms[h.geom].mesh.bvh.refs);
+    }
+    assert_int_equal(h.prim, want->prim);
+    return 1;
+}
+
 static void scene_packet_equals_items(uint32_t flags)
 {
     enum { SMALL = 40, MESHES = SMALL + 3 };
@@ -325,19 +346,9 @@ static void scene_packet_equals_items(uint32_t flags)
             if ((skip >> j) & 1u)
                 rc__mesh_intersect_packet(&scene->geoms[j].mesh, rays, n, j, RC_INVALID_ID, hits, found, flags);
         for (i = 0; i < n; ++i) want_found[i] |= rc__scene_intersect_items(scene, &rays[i], &want[i], 0u);
-        for (i = 0; i < n; ++i) {
-            rc__hit h = hits[i];
-            assert_int_equal(found[i], want_found[i]);
-            if (!found[i]) continue;
-            assert_memory_equal(&h.t, &want[i].t, sizeof(float));
-            assert_int_equal(h.geom, want[i].geom);
-            if (h.prim == RC__PRIM_PENDING) {
-                assert_true(flags & RC__PACKET_PRIMS_PENDING);
-                rc__hit_settle(&h, scene->geoms[h.geom].mesh.bvh.refs);
-            }
-            assert_int_equal(h.prim, want[i].prim);
-            geoms_met += met[h.geom]++ == 0u;
-        }
+        for (i = 0; i < n; ++i)
+            if (walk_hit_equal(scene, &hits[i], found[i], &want[i], want_found[i], flags))
+                geoms_met += met[hits[i].geom]++ == 0u;
     }
     /* many meshes were met (22 of 43 in the quick run's 200 tiles, 42 in
      * 2,000), and the box won every tie with its copy */
@@ -351,18 +362,122 @@ static void scene_packet_equals_items(uint32_t flags)
     for (j = 0; j < SMALL; ++j) rcu_mesh_free(&small[j]);
 }
 
+/* Instances take the packets too (rc__scene_intersect_packet_instances): the
+ * same hits as rc__scene_intersect_items ray by ray over the instances, for
+ * instances turned, scaled (uniformly, per axis, mirrored) and one an exact
+ * copy of another (its ties lost to the lower instance id), a source of two
+ * meshes, lanes that start from nearer hits, and every flag combination. */
+static void instances_packet_equals_items(uint32_t flags)
+{
+    enum { INSTANCES = 12 };
+    const int own_origins = (flags & RC__PACKET_OWN_ORIGINS) != 0u;
+    const float lo[3] = {-1.0f, -0.8f, -0.6f}, hi[3] = {1.0f, 0.8f, 0.6f};
+    rcu_mesh sphere, box, ball, ball2;
+    const rcu_mesh *own[2], *parts[2];
+    rc_context *ctx = rct_context(RC_BACKEND_BVH, 1, 0);
+    rc_scene *src, *scene;
+    rc_scene_desc sd = rc_scene_desc_default();
+    uint32_t tile, tiles = rct_quick() ? 200u : 2000u, j, met[INSTANCES] = {0}, insts_met = 0;
+    print_message("a packet through %u instances%s%s\n", (unsigned)INSTANCES, own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
+    assert_int_equal(rcu_mesh_uv_sphere(20.0f, 60, 30, &sphere), 0);
+    assert_int_equal(rcu_mesh_box(box_lo, box_hi, &box), 0);
+    assert_int_equal(rcu_mesh_box(lo, hi, &ball), 0);
+    {
+        const float at[3] = {1.6f, 0.0f, 0.3f};
+        assert_int_equal(rcu_mesh_uv_sphere(0.7f, 12, 6, &ball2), 0);
+        rcu_mesh_transform(&ball2, 0.0f, at);
+        parts[0] = &ball;
+        parts[1] = &ball2;
+        src = rct_scene_meshes(ctx, parts, 2u);
+    }
+    own[0] = &sphere;
+    own[1] = &box;
+    sd.max_geometries = 2u;
+    sd.max_triangles = sphere.triangle_count + box.triangle_count;
+    sd.max_instances = INSTANCES;
+    RCT_OK(ctx, rc_scene_create(ctx, &sd, &scene));
+    for (j = 0; j < 2u; ++j) {
+        rc_mesh_desc md = rc_mesh_desc_default();
+        uint32_t id;
+        md.vertices = own[j]->vertices;
+        md.vertex_count = own[j]->vertex_count;
+        md.indices = own[j]->indices;
+        md.triangle_count = own[j]->triangle_count;
+        RCT_OK(ctx, rc_scene_add_mesh(scene, &md, &id));
+    }
+    for (j = 0; j < INSTANCES; ++j) {
+        rc_instance_desc in = rc_instance_desc_default();
+        const uint32_t k = j == INSTANCES - 1u ? j - 1u : j; /* the last a copy of the one before */
+        const double yaw = 0.7 * k, half = 0.5 * yaw;
+        uint32_t id;
+        in.source = src;
+        in.transform = rc_pose_identity();
+        in.transform.position[0] = -7.5f + 5.0f * (float)(k % 4u);
+        in.transform.position[1] = -6.0f + 6.0f * (float)((k / 4u) % 3u);
+        in.transform.position[2] = -3.0f + 2.5f * (float)(k % 3u);
+        in.transform.orientation[2] = (float)sin(half);
+        in.transform.orientation[3] = (float)cos(half);
+        if (k % 4u == 1u) in.scale[0] = in.scale[1] = in.scale[2] = 1.5f;
+        if (k % 4u == 2u) in.scale[0] = 1.0f, in.scale[1] = 2.0f, in.scale[2] = 0.5f;
+        if (k % 4u == 3u) in.scale[0] = -1.0f, in.scale[1] = 1.0f, in.scale[2] = 1.0f;
+        RCT_OK(ctx, rc_scene_add_instance(scene, &in, &id));
+    }
+    RCT_OK(ctx, rc_scene_commit(scene));
+    for (tile = 0; tile < tiles; ++tile) {
+        rc__ray rays[RC__PACKET_SIZE];
+        rc__hit hits[RC__PACKET_SIZE], want[RC__PACKET_SIZE];
+        int found[RC__PACKET_SIZE], want_found[RC__PACKET_SIZE];
+        const uint32_t n = make_tile(tile, rays, hits, found, own_origins);
+        uint32_t i;
+        if (tile % 4u == 2u)
+            for (i = 0; i < n; i += 2u) hits[i].t = 4.0f;
+        memcpy(want, hits, sizeof want);
+        memcpy(want_found, found, sizeof want_found);
+        rc__scene_intersect_packet_instances(scene, rays, n, hits, found, flags);
+        for (i = 0; i < n; ++i) want_found[i] |= rc__scene_intersect_items(scene, &rays[i], &want[i], scene->geom_count);
+        for (i = 0; i < n; ++i)
+            if (walk_hit_equal(scene, &hits[i], found[i], &want[i], want_found[i], flags))
+                insts_met += met[hits[i].inst]++ == 0u;
+    }
+    /* most instances were met, and the copy lost every tie to its original */
+    assert_true(insts_met >= (rct_quick() ? 5u : 8u));
+    assert_int_equal(met[INSTANCES - 1u], 0u);
+    assert_true(met[INSTANCES - 2u] > 0u);
+    rc_scene_destroy(scene);
+    rc_scene_destroy(src);
+    rc_context_destroy(ctx);
+    rcu_mesh_free(&sphere);
+    rcu_mesh_free(&box);
+    rcu_mesh_free(&ball);
+    rcu_mesh_free(&ball2);
+}
+
+/* check under every flag combination (0, own origins, prim ids pending,
+ * both) where the build has the top-level walk; -Os builds skip */
+static void each_flag_walk(void (*check)(uint32_t), const char *without)
+{
+#if defined(RC__PACKET_MESHES)
+    uint32_t flags;
+    (void)without;
+    for (flags = 0; flags < 4u; ++flags) check(flags);
+#else
+    (void)check;
+    print_message("an -Os build: %s go ray by ray\n", without);
+    skip();
+#endif
+}
+
+static void test_instances_packet_equals_items(void **state)
+{
+    (void)state;
+    each_flag_walk(instances_packet_equals_items, "instances");
+}
+
 static void test_scene_packet_equals_items(void **state)
 {
     (void)state;
-#if defined(RC__PACKET_MESHES)
-    {
-        uint32_t flags;
-        for (flags = 0; flags < 4u; ++flags) scene_packet_equals_items(flags);
-    }
-#else
-    print_message("an -Os build: scenes of many meshes go ray by ray\n");
-    skip();
-#endif
+    each_flag_walk(scene_packet_equals_items, "scenes of many meshes");
 }
 
 static void test_packet_meshes_equal_meshwise(void **state)
@@ -497,6 +612,7 @@ int main(void)
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_packet_meshes_equal_meshwise),
                                        cmocka_unit_test(test_scene_packet_equals_items),
+                                       cmocka_unit_test(test_instances_packet_equals_items),
                                        cmocka_unit_test(test_large_mesh_threshold)};
     return cmocka_run_group_tests_name("packet traversal", tests, NULL, NULL);
 }

@@ -120,6 +120,13 @@ static inline int rc__scene_intersect(const rc_scene *scene, const rc__ray *ray,
  * rc__scene_intersect_items ray by ray up to the instances. */
 void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
                                 int *found, uint32_t flags);
+/* The same walk through the scene's instances only (after its own meshes were
+ * searched another way): each instance some ray may meet takes the packet,
+ * its rays moved into the instance's frame as rc__scene_intersect_items
+ * moves each, through its source's meshes. The same hits as
+ * rc__scene_intersect_items(scene, ray, hit, geom_count) ray by ray. */
+void rc__scene_intersect_packet_instances(const rc_scene *scene, const rc__ray *rays, uint32_t n, rc__hit *hits,
+                                          int *found, uint32_t flags);
 #endif
 
 /* The hit's distance recomputed in double: the ray (sensor-frame direction

@@ -40,19 +40,26 @@ static int box_hit(const rc__ray *r, const float bmin[3], const float bmax[3], f
     return t0 <= t1 * RC__SLAB_FAR_SCALE;
 }
 
-static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc__ray *ray, rc__hit *hit)
+/* ray in the instance's frame: the same parameter t along it (its direction
+ * is moved, not normalised) */
+static void instance_ray(const rc__instance *in, const rc__ray *ray, rc__ray *local)
 {
-    const rc_scene *src = in->source;
-    rc__ray local;
     float o[3], d[3];
-    uint32_t g;
-    int found = 0;
     rc__rot_apply_f(in->to_local.r, ray->org, o);
     o[0] += in->to_local.t[0];
     o[1] += in->to_local.t[1];
     o[2] += in->to_local.t[2];
     rc__rot_apply_f(in->to_local.r, ray->dir, d);
-    rc__ray_prepare(&local, o, d);
+    rc__ray_prepare(local, o, d);
+}
+
+static int instance_intersect(const rc__instance *in, uint32_t inst_id, const rc__ray *ray, rc__hit *hit)
+{
+    const rc_scene *src = in->source;
+    rc__ray local;
+    uint32_t g;
+    int found = 0;
+    instance_ray(in, ray, &local);
     /* Sources hold a few meshes: test each mesh's root through its own BVH. */
     for (g = 0; g < src->geom_count; ++g) found |= rc__mesh_intersect(&src->geoms[g].mesh, &local, g, inst_id, hit);
     return found;
@@ -240,8 +247,34 @@ static int packet_span_box_hit(const packet_span *s, const rc__bvh_node *nd)
 }
 #endif
 
-void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
-                                int *found, uint32_t flags)
+/* A packet through one instance: its rays moved as instance_ray moves each
+ * (rays that share an origin still share it, bit for bit), then through the
+ * source's meshes RC__SCENE_PACKET_BATCH at a time. */
+static void instance_intersect_packet(const rc__instance *in, uint32_t inst_id, const rc__ray *rays, uint32_t n,
+                                      rc__hit *hits, int *found, uint32_t flags)
+{
+    const rc_scene *src = in->source;
+    rc__ray local[RC__PACKET_SIZE];
+    const rc__mesh *meshes[RC__SCENE_PACKET_BATCH];
+    uint32_t geoms[RC__SCENE_PACKET_BATCH], i, g, count;
+    if (n > RC__PACKET_SIZE) { /* (a packet is at most that: not met) */
+        for (i = 0; i < n; ++i) found[i] |= instance_intersect(in, inst_id, &rays[i], &hits[i]);
+        return;
+    }
+    for (i = 0; i < n; ++i) instance_ray(in, &rays[i], &local[i]);
+    for (g = 0; g < src->geom_count; g += count) {
+        for (count = 0; count < RC__SCENE_PACKET_BATCH && g + count < src->geom_count; ++count) {
+            meshes[count] = &src->geoms[g + count].mesh;
+            geoms[count] = g + count;
+        }
+        rc__mesh_intersect_packet_meshes(meshes, geoms, count, local, n, inst_id, hits, found, flags);
+    }
+}
+
+/* The walk of rc__scene_intersect_packet (instances 0: the own meshes) and
+ * of rc__scene_intersect_packet_instances (instances 1) */
+static void packet_walk(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
+                        int *found, uint32_t flags, int instances)
 {
     uint32_t stack[RC__BVH_MAX_DEPTH + 1];
     const rc__mesh *batch[RC__SCENE_PACKET_BATCH];
@@ -262,6 +295,13 @@ void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint
                 uint32_t k;
                 for (k = 0; k < nd->count; ++k) {
                     const uint32_t item = top->refs[nd->index + k];
+                    if (instances) {
+                        if (item < scene->geom_count) continue;
+                        instance_intersect_packet(&scene->insts[item - scene->geom_count], item - scene->geom_count,
+                                                  rays, n, hits, found, flags);
+                        packet_span_of(rays, n, hits, &span);
+                        continue;
+                    }
                     if (item >= scene->geom_count || (item < 32u && ((skip >> item) & 1u))) continue;
                     batch[count] = &scene->geoms[item].mesh;
                     batch_geoms[count++] = item;
@@ -279,6 +319,18 @@ void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint
         ni = stack[--sp];
     }
     if (count) rc__mesh_intersect_packet_meshes(batch, batch_geoms, count, rays, n, RC_INVALID_ID, hits, found, flags);
+}
+
+void rc__scene_intersect_packet(const rc_scene *scene, const rc__ray *rays, uint32_t n, uint32_t skip, rc__hit *hits,
+                                int *found, uint32_t flags)
+{
+    packet_walk(scene, rays, n, skip, hits, found, flags, 0);
+}
+
+void rc__scene_intersect_packet_instances(const rc_scene *scene, const rc__ray *rays, uint32_t n, rc__hit *hits,
+                                          int *found, uint32_t flags)
+{
+    packet_walk(scene, rays, n, 0u, hits, found, flags, 1);
 }
 #endif
 

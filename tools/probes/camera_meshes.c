@@ -10,7 +10,9 @@
  *       build/librangecast.a build/tools/librcutil.a -lm -lpthread \
  *       [-lembree3] [-lvulkan] -o /tmp/camera_meshes
  *   /tmp/camera_meshes THREADS LAYOUT [BALLS [POSES [SEGMENTS [PRESET [BACKEND]]]]]
- * LAYOUT 0: one merged mesh; 1: the room and each ball a geometry of its own.
+ * LAYOUT 0: one merged mesh; 1: the room and each ball a geometry of its own;
+ * 2: the room a mesh, each ball an instance of one unit ball scene (its
+ * checksum differs in the last digits: the instances' rounding).
  * BALLS (default 24, at most 1024) UV balls of SEGMENTS (default 48) segments
  * and half as many rings, 0.3 to 0.7 m, on a 6 x 6 grid in a 12 x 12 x 3 m
  * room (more than 36 balls: a finer grid, the balls smaller in proportion);
@@ -30,7 +32,7 @@ int main(int argc, char **argv)
     rc_context_desc cd = rc_context_desc_default();
     rc_scene_desc sd = rc_scene_desc_default();
     rc_context *ctx = NULL;
-    rc_scene *scene = NULL;
+    rc_scene *scene = NULL, *ball_scene = NULL;
     rc_sensor *sensor = NULL;
     rc_sensor_info info = rc_sensor_info_default();
     rcu_mesh room, *balls, merged;
@@ -67,10 +69,37 @@ int main(int argc, char **argv)
         if (rcu_mesh_append(&merged, &balls[i]) != 0) return fail(NULL, "merge");
     }
     if (rc_context_create(&cd, &ctx) != RC_OK) return fail(NULL, "rc_context_create");
-    sd.max_geometries = layout ? nballs + 1u : 1u;
-    sd.max_triangles = merged.triangle_count;
+    sd.max_geometries = layout == 1u ? nballs + 1u : 1u;
+    sd.max_triangles = layout == 2u ? room.triangle_count : merged.triangle_count;
+    sd.max_instances = layout == 2u ? nballs : 0u;
     if (rc_scene_create(ctx, &sd, &scene) != RC_OK) return fail(ctx, "scene");
-    if (layout) {
+    if (layout == 2u) {
+        /* the room, and each ball an instance of one unit ball (scaled and
+         * placed as its mesh is in the other layouts, to within rounding) */
+        rc_scene_desc bd = rc_scene_desc_default();
+        rcu_mesh unit;
+        if (rcu_mesh_uv_sphere(1.0f, segments, segments / 2u, &unit) != 0) return fail(NULL, "unit ball");
+        bd.max_triangles = bd.max_copied_triangles = unit.triangle_count;
+        bd.max_vertices = unit.vertex_count;
+        if (rc_scene_create(ctx, &bd, &ball_scene) != RC_OK || probe_add_mesh(ball_scene, &unit, RC_MESH_COPY) != RC_OK ||
+            rc_scene_commit(ball_scene) != RC_OK)
+            return fail(ctx, "unit ball scene");
+        rcu_mesh_free(&unit);
+        if (probe_add_mesh(scene, &room, RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "room mesh");
+        for (g = 0; g < nballs; ++g) {
+            rc_instance_desc id = rc_instance_desc_default();
+            const float step = 10.8f / (float)cols, scale = step / 1.8f;
+            const float r = scale * (0.3f + 0.1f * (float)(g % 5u));
+            id.source = ball_scene;
+            id.transform = rc_pose_identity();
+            id.transform.position[0] = -5.4f + step * (0.5f + (float)(g % cols));
+            id.transform.position[1] = -5.4f + step * (0.5f + (float)(g / cols));
+            id.transform.position[2] = 0.5f + 0.4f * (float)(g % 4u);
+            id.scale[0] = id.scale[1] = id.scale[2] = r;
+            uint32_t inst_id;
+            if (rc_scene_add_instance(scene, &id, &inst_id) != RC_OK) return fail(ctx, "instance");
+        }
+    } else if (layout) {
         if (probe_add_mesh(scene, &room, RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "room mesh");
         for (g = 0; g < nballs; ++g)
             if (probe_add_mesh(scene, &balls[g], RC_MESH_REFERENCE) != RC_OK) return fail(ctx, "ball mesh");
@@ -96,7 +125,8 @@ int main(int argc, char **argv)
     }
     if (probe_time_ranges(ctx, scene, sensor, poses, poses_n, rays, ranges, &best, &sum) != 0) return 1;
     printf("%u triangles in %u geometries, %u threads: %.1f scans/s (best of 3), range checksum %.6f\n",
-           merged.triangle_count, layout ? nballs + 1u : 1u, cd.thread_count, poses_n / best, sum);
+           merged.triangle_count, layout == 1u ? nballs + 1u : layout == 2u ? nballs + 1u : 1u, cd.thread_count,
+           poses_n / best, sum);
     rc_context_destroy(ctx);
     rcu_mesh_free(&room);
     rcu_mesh_free(&merged);
