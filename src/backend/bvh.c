@@ -206,8 +206,8 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
     /* the instances (all items without packets or runs: a scene of many
      * meshes); after the own meshes each ray keeps its nearest hit, and
      * the tie rule does not depend on the order. Packets walk the top-level
-     * tree for them too (a VLP-16 among 64 instanced balls, 2 threads: 119
-     * scans/s ray by ray, Embree 243; session 42). */
+     * tree for them too (a VLP-16 among 64 instanced balls, 2 threads: 85
+     * scans/s ray by ray, 207 in packets, Embree 243-250; session 42). */
 #if defined(RC__PACKET_MESHES)
     if (run->packets && scene->inst_count != 0) {
         for (k = 0; k < group; ++k)
