@@ -4,7 +4,9 @@
  * sensor position and up to 64 rays, as an O1Dn sensor (the packet
  * traversal) or an OnDn one (single rays), or a spherical or pinhole grid of
  * up to 8 x 8 rays (the packets over the grid's tiles). The triangles go
- * into one mesh or are split over up to four, and the scene may hold up to
+ * into one mesh or are split over up to 40 (packets mesh by mesh, a walk of
+ * the top-level tree from 8 meshes, past the 32 the packets take one by one
+ * from 33), and the scene may hold up to
  * four instances of a scene of those meshes (turned, scaled, mirrored: the
  * two-level tree), the meshes themselves beside them or not. The traversals that take turns on
  * large maps can be forced. Promised: every ray's hit, and the triangle,
@@ -28,7 +30,7 @@
 
 #define MAX_TRIS 256u
 #define MAX_RAYS 64u
-#define MAX_MESHES 4u
+#define MAX_MESHES 40u
 #define MAX_INSTANCES 4u
 #define RANGE_MAX 1.0e6f
 
