@@ -132,6 +132,20 @@ static inline int rc__node_hit(const rc__bvh_node *n, const rc__slab_ray *s, flo
 #define RC__PREFETCH(p) ((void)(p))
 #endif
 
+/* Index of the lowest set bit of m (m != 0): where the set bits are lanes or
+ * slots that lie anywhere in a mask, a loop shifting to the next one would
+ * mispredict on the gaps. */
+static RC__FORCE_INLINE uint32_t rc__lowest_bit(uint32_t m)
+{
+#if defined(__GNUC__)
+    return (uint32_t)__builtin_ctz(m);
+#else
+    uint32_t b = 0;
+    while (!((m >> b) & 1u)) ++b;
+    return b;
+#endif
+}
+
 /* double to float without overflow (huge coordinates). */
 static inline float rc__clamp_to_float(double d)
 {

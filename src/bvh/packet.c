@@ -290,19 +290,6 @@ static inline uint32_t children_maybe_hit(const node_planes *pl, const packet_bo
  * lanes measured slower than four). */
 #define FEW_LANES 4u
 
-/* Index of the lowest set bit (mask != 0). Live lanes lie anywhere in the
- * mask, so a loop shifting to the next one would mispredict. */
-static RC__FORCE_INLINE uint32_t lowest_lane(uint32_t mask)
-{
-#if defined(__GNUC__)
-    return (uint32_t)__builtin_ctz(mask);
-#else
-    uint32_t lane = 0;
-    while (!((mask >> lane) & 1u)) ++lane;
-    return lane;
-#endif
-}
-
 /* 1 when mask has at most FEW_LANES lanes: one instruction where the build
  * has POPCNT (the AVX2 build: every AVX2 CPU has it), else the lowest
  * FEW_LANES bits cleared one by one. */
@@ -333,7 +320,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
     __m128i metv = _mm_loadu_si128((const __m128i *)(const void *)met);
     __m128 near = _mm_set1_ps(INFINITY); /* entry distances are never NaN: min(tl, inf) = tl */
     while (mask) {
-        const uint32_t lane = lowest_lane(mask);
+        const uint32_t lane = rc__lowest_bit(mask);
         float inv[3], tl[4] RC__ALIGN16;
         __m128 in;
         mask &= mask - 1u;
@@ -352,7 +339,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met(const rc__wnode *n, const packet_
     uint32_t any = 0;
     int first = 1;
     while (mask) {
-        const uint32_t lane = lowest_lane(mask);
+        const uint32_t lane = rc__lowest_bit(mask);
         float inv[3], tl[4];
         uint32_t h, c;
         mask &= mask - 1u;
@@ -396,7 +383,7 @@ static RC__FORCE_INLINE uint32_t few_lanes_met_shared(const rc__wnode *n, const 
     __m128i metv = _mm_loadu_si128((const __m128i *)(const void *)met);
     __m128 near = _mm_set1_ps(INFINITY); /* entry distances are never NaN: min(t0, inf) = t0 */
     while (mask) {
-        const uint32_t lane = lowest_lane(mask);
+        const uint32_t lane = rc__lowest_bit(mask);
         __m128 t0;
         const __m128 in = rc__wide_box_from_planes(pnx, pny, pnz, pfx, pfy, pfz, _mm_set1_ps(L->ix[lane]),
                                                    _mm_set1_ps(L->iy[lane]), _mm_set1_ps(L->iz[lane]),
@@ -729,7 +716,7 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
         rc__hit *h = &T->hits[lane];
         int took = 0;
         while (cand) {
-            const uint32_t c = lowest_lane(cand);
+            const uint32_t c = rc__lowest_bit(cand);
             cand &= cand - 1u;
             took |= rc__hit_offer_slot(h, lo->t[c], mesh->bvh.refs, child + c, geom, inst);
         }
@@ -742,7 +729,7 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
     }
 #endif
     while (cand) {
-        const uint32_t c = lowest_lane(cand); /* a triangle slot here, not a lane */
+        const uint32_t c = rc__lowest_bit(cand); /* a triangle slot here, not a lane */
         float t;
         cand &= cand - 1u;
         if (!rc__leaf4_take(lo, c, &T->rays[lane], vt[c], known, flat, &t)) continue;
@@ -784,7 +771,7 @@ static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uin
                 rc__wide_entry *const e = stack + sp;
                 uint32_t m = 0;
                 while (met) {
-                    const uint32_t c = lowest_lane(met);
+                    const uint32_t c = rc__lowest_bit(met);
                     met &= met - 1u;
                     if (n->child[c] == RC__WIDE_EMPTY) continue;
                     rc__prefetch_next(nodes, mesh->leaf_tris, n->child[c], n->count[c]);
@@ -843,7 +830,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     if (!interleaved && !(mask & (mask - 1u))) {
         /* one live lane: the rest of this subtree is that lane's alone */
         int shrunk = 0;
-        lone_lane(T, mesh, lowest_lane(mask), child, T->count, geom, inst, &shrunk);
+        lone_lane(T, mesh, rc__lowest_bit(mask), child, T->count, geom, inst, &shrunk);
         if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L);
     } else
 #endif
@@ -872,7 +859,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
         }
         while (maybe) {
             uint32_t mc;
-            c = lowest_lane(maybe); /* a child slot here, not a lane */
+            c = rc__lowest_bit(maybe); /* a child slot here, not a lane */
             maybe &= maybe - 1u;
             if (nd->child[c] == RC__WIDE_EMPTY) continue;
             mc = few ? lanes_met[c] : box_mask(&pl, c, L, mask);
@@ -942,7 +929,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
          * in registers, without the copy (1M +2.6%); the loop below then has
          * nothing left */
         if (!(m & (m - 1u))) {
-            const uint32_t lane = lowest_lane(m);
+            const uint32_t lane = rc__lowest_bit(m);
 #if defined(RC__PACKET_AVX2)
             /* four triangles (nearly every leaf) as a constant: no selects for missing slots */
             if (n_tri == 4u)
@@ -956,11 +943,11 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
 #endif
         rc__leaf4_transpose((const float *const(*)[3])vt, n_tri, &soa);
         while (m) {
-            const uint32_t lane = lowest_lane(m);
+            const uint32_t lane = rc__lowest_bit(m);
             m &= m - 1u;
 #if defined(RC__PACKET_AVX2)
             if (m) {
-                const uint32_t lane2 = lowest_lane(m);
+                const uint32_t lane2 = rc__lowest_bit(m);
                 rc__leaf4_out lo2;
                 m &= m - 1u;
                 rc__leaf4_test_soa_pair(&rays[lane], &rays[lane2], &soa, n_tri, &lo, &lo2);
