@@ -7,8 +7,9 @@
  * instances searched after them, each on 1 and 2 threads, two poses, partial
  * tile groups. Every ray must report the same triangle, geometry and
  * instance, with or without prim ids asked for (without, the hits may
- * leave theirs pending, also across meshes and instances). On x86 also the packets' refinement of a tile's hits two at a
- * time, against the one-hit function (the Embree backend's batches use it
+ * leave theirs pending, also across meshes and instances). On x86 and
+ * AArch64 also the packets' refinement of a tile's hits in groups (two or
+ * four at a time), against the one-hit function (the Embree backend's batches use it
  * too, with hits that carry no leaf slot). (test_packet.c and test_wide.c check the traversals bit for bit;
  * this checks the backend's grouping of tiles and meshes around them.) The
  * context's threshold is set by the test, whatever this CPU's cache. */
@@ -103,7 +104,7 @@ static void check_sensor(rc_context *ctx, rc_scene *scene, const rc_sensor *sens
     rct_buffers_free(&buf);
 }
 
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
 /* The refinement of a tile's hits in groups (rc__scene_hit_distances_d)
  * against rc__scene_hit_distance_d one at a time: the same doubles, for
  * tiles of 1..RC__PACKET_SIZE rays with misses and instance hits among
@@ -211,7 +212,7 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
         assert_true(ondn_beams->origin_spread2 > 0.0f &&
                     ondn_beams->origin_spread2 <= RC__PACKET_ORIGIN_SPREAD * RC__PACKET_ORIGIN_SPREAD);
         check_sensor(ctx, scene, o1dn, rays);
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
         check_distances(scene, o1dn, rays);
 #endif
         check_sensor(ctx, scene, ondn, rays);

@@ -81,7 +81,7 @@ void rc__write_results_run(const rc__sim_job *job, uint64_t base, uint32_t first
 int rc__raster_grid_of(const rc_sensor *s, rc__raster_grid *g);
 #endif
 
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
 /* rc__write_result for n rays of one pose of a one-origin sensor (a packet
  * tile, or a run of the Embree backend's batch; n <= RC__PACKET_SIZE; ray i
  * is element base + idx[i]; no normals passed in), their distances refined

@@ -326,7 +326,7 @@ static void trace_tiles(const sim_run *run, const uint32_t *recs, uint32_t first
         trace_group(run, job->scene, group, rays, n, hits, found);
         for (k = 0; k < group; ++k) {
             uint64_t base = (uint64_t)(pose0 + pose[k]) * sensor->rays;
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
             if (!sensor->origins) {
                 rc__write_results_tile(job, base, idx[k], n[k], found[k], hits[k], &worlds[pose[k]]);
                 continue;

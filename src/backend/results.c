@@ -7,7 +7,7 @@
 #include "bvh/intersect.h" /* RC__FORCE_INLINE */
 #include "bvh/scan_raster.h" /* RC__PROJECTED_SCANS */
 #include "core/work_order.h"
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
 #include "bvh/packet.h" /* RC__PACKET_SIZE */
 #endif
 
@@ -212,7 +212,7 @@ void rc__write_results_run(const rc__sim_job *job, uint64_t base, uint32_t first
 }
 #endif
 
-#if defined(RC__HIT_DISTANCES_SSE2)
+#if defined(RC__HIT_DISTANCES_LANES)
 void rc__write_results_tile(const rc__sim_job *job, uint64_t base, const uint32_t *idx, uint32_t n, const int *found,
                             const rc__hit *hits, const rc__xformf *world)
 {

@@ -139,13 +139,19 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
 
 #if defined(__SSE2__) && !defined(RC__WIDE_FORCE_SCALAR)
 #include <emmintrin.h>
+#define RC__HIT_DISTANCES_SSE2 1 /* x86's parts of the grouped refinement and writer */
+#endif
 /* rc__scene_hit_distance_d for the n rays of a tile of a one-origin sensor
  * (ray i: sensor direction directions[3 * idx[i]], hit hits[i] where
  * found[i]), two hits at a time in SSE2 doubles (four in AVX where the CPU
- * has AVX2), each value bit for bit the scalar function's; td[i] = 0 where
- * found[i] is 0. (1k sphere: the refinement one hit at a time was 17% of
- * the instructions.) */
-#define RC__HIT_DISTANCES_SSE2 1
+ * has AVX2) or AArch64 NEON doubles, each value bit for bit the scalar
+ * function's; td[i] = 0 where found[i] is 0. (1k sphere: the refinement one
+ * hit at a time was 17% of the instructions.) Left out of -Os builds on
+ * AArch64 (the static core's size budget), where tiles are written ray by
+ * ray with the same values. */
+#if defined(RC__HIT_DISTANCES_SSE2) ||                                                                               \
+    (defined(__aarch64__) && defined(__ARM_NEON) && !defined(__OPTIMIZE_SIZE__) && !defined(RC__WIDE_FORCE_SCALAR))
+#define RC__HIT_DISTANCES_LANES 1
 void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const int *found, uint32_t n,
                                const rc__xformf *world, const float *directions, const uint32_t *idx, double *td);
 #endif

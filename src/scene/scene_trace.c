@@ -574,6 +574,7 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
     return w / dn;
 }
 
+#if defined(RC__HIT_DISTANCES_LANES)
 #if defined(RC__HIT_DISTANCES_SSE2)
 /* Hits refined two at a time in SSE2 doubles (hit_distance_lanes.h) */
 #define RC__HD_NAME distance_lanes2
@@ -592,6 +593,31 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
                               _mm_cmpnlt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), q), _mm_set1_pd(INFINITY))))
 #define RC__HD_STORE(p, v) _mm_storeu_pd(p, v)
 #include "scene/hit_distance_lanes.h"
+#else
+/* ... or in AArch64 NEON doubles: the same IEEE operations (the build turns
+ * fused multiply-add off), so the same values */
+#include <arm_neon.h>
+#define RC__HD_NAME distance_lanes2
+#define RC__HD_ATTR
+#define RC__HD_W 2
+#define RC__HD_T float64x2_t
+#define RC__HD_SET1(x) vdupq_n_f64(x)
+#define RC__HD_ADD(a, b) vaddq_f64(a, b)
+#define RC__HD_SUB(a, b) vsubq_f64(a, b)
+#define RC__HD_MUL(a, b) vmulq_f64(a, b)
+#define RC__HD_DIV(a, b) vdivq_f64(a, b)
+#define RC__HD_GATHER(p, k) vsetq_lane_f64((double)(p)[1][k], vdupq_n_f64((double)(p)[0][k]), 1)
+/* not |q| < inf: inf or NaN */
+#define RC__HD_ODD(dn, q) rc__hd_odd_neon(dn, q)
+#define RC__HD_STORE(p, v) vst1q_f64(p, v)
+static inline int rc__hd_odd_neon(float64x2_t dn, float64x2_t q)
+{
+    const uint64x2_t odd = vorrq_u64(vceqq_f64(dn, vdupq_n_f64(0.0)),
+                                     veorq_u64(vcltq_f64(vabsq_f64(q), vdupq_n_f64(INFINITY)), vdupq_n_u64(~0ull)));
+    return (int)((vgetq_lane_u64(odd, 0) & 1u) | (vgetq_lane_u64(odd, 1) & 2u));
+}
+#include "scene/hit_distance_lanes.h"
+#endif
 
 #if defined(RC__LEAF4_PAIR_AVX2)
 /* ... and four at a time in AVX doubles where the CPU has AVX2
