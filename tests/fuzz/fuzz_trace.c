@@ -14,7 +14,8 @@
  * every mesh and instance with the same watertight test and tie rule, one by
  * one (instances with the ray turned into their frame as the library turns
  * it): the trees' box tests only ever skip triangles that cannot win, except
- * a tie the box slack cannot settle (tie_beyond_slack) and a triangle whose
+ * a triangle whose t the box slack cannot cover (beyond_slack: a tie, or a
+ * nearer hit by the rounding of a needle's t) and a triangle whose
  * own bounding box the slab test says the ray misses (meets_own_box). A hit's
  * point lies at its range along its ray, and its normal is a unit vector
  * facing the sensor. */
@@ -169,16 +170,17 @@ static double plane_distance(const rc__ray *r, const float *a, const float *b, c
            (nx * r->dir[0] + ny * r->dir[1] + nz * r->dir[2]);
 }
 
-/* 1 when the library's hit (geom, prim, inst) ties with the nearest of all
- * triangles h (the same t), names a larger key, and h's triangle lies further
- * beyond its t than the trees' slack covers. The trees drop a box whose entry
- * distance passes the nearest t by more than RC__SLAB_FAR_SCALE (less the
- * slab test's own 4 ulps); a box holding h's triangle enters no later than the
- * triangle's exact distance, so only then can it be dropped, and the tie go by
- * search order: the documented limit of the tie rule (docs/architecture.md,
- * "The BVH"), not a traversal fault. */
-static int tie_beyond_slack(const rc_scene *scene, const float *verts, const mesh_split *ms, const float org[3],
-                            const float dir[3], const rc__hit *h, uint32_t geom, uint32_t prim, uint32_t inst)
+/* 1 when the library's hit (geom, prim, inst), at t by the same test, is
+ * no nearer than the nearest of all triangles h (at the same t it names a
+ * larger key), and h's triangle lies further beyond t than the trees' slack
+ * covers. The trees drop a box whose entry distance passes the nearest t so
+ * far by more than RC__SLAB_FAR_SCALE (less the slab test's own 4 ulps); a
+ * box holding h's triangle enters no later than the triangle's exact
+ * distance, so only then can it be dropped once the library's hit is found:
+ * the documented limit of triangles whose t carries more rounding than the
+ * slack (docs/architecture.md, "The BVH"), not a traversal fault. */
+static int beyond_slack(const rc_scene *scene, const float *verts, const mesh_split *ms, const float org[3],
+                        const float dir[3], const rc__hit *h, uint32_t geom, uint32_t prim, uint32_t inst)
 {
     rc__ray lr, hr;
     rc__hit lib;
@@ -188,23 +190,24 @@ static int tie_beyond_slack(const rc_scene *scene, const float *verts, const mes
     lib.prim = prim;
     lib.geom = geom;
     lib.inst = inst;
-    if (!rc__hit_key_less(h->inst, h->geom, h->prim, &lib)) return 0;
     lib_tri = verts + 9u * (ms->first[geom] + prim);
     ray_in_frame(scene, inst, org, dir, &lr);
-    if (!rc__tri_intersect(&lr, lib_tri, lib_tri + 3, lib_tri + 6, &t, &u, &v) || t != h->t) return 0;
+    if (!rc__tri_intersect(&lr, lib_tri, lib_tri + 3, lib_tri + 6, &t, &u, &v) || t < h->t) return 0;
+    if (t == h->t && !rc__hit_key_less(h->inst, h->geom, h->prim, &lib)) return 0;
     h_tri = verts + 9u * (ms->first[h->geom] + h->prim);
     ray_in_frame(scene, h->inst, org, dir, &hr);
-    return plane_distance(&hr, h_tri, h_tri + 3, h_tri + 6) > (double)h->t * (1.0 + 28.0 * FLT_EPSILON);
+    return plane_distance(&hr, h_tri, h_tri + 3, h_tri + 6) > (double)t * (1.0 + 28.0 * FLT_EPSILON);
 }
 
 /* 1 when the library's answer for a ray (hit, and its geom, prim, inst)
- * names the nearest hit h, or ties with it beyond the trees' slack. */
+ * names the nearest hit h, or one that h lies beyond by more than the
+ * trees' slack (beyond_slack). */
 static int library_is(const rc_scene *scene, const float *verts, const mesh_split *ms, const float org[3],
                       const float dir[3], const rc__hit *h, uint8_t hit, uint32_t geom, uint32_t prim, uint32_t inst)
 {
     if ((h->prim != RC_INVALID_ID) != (hit != 0)) return 0;
     return !hit || (prim == h->prim && geom == h->geom && inst == h->inst) ||
-           tie_beyond_slack(scene, verts, ms, org, dir, h, geom, prim, inst);
+           beyond_slack(scene, verts, ms, org, dir, h, geom, prim, inst);
 }
 
 /* Adds the split meshes to scene (copied, so the arrays can be reused). */
