@@ -7,6 +7,9 @@
 # NEON/SSE either) and against single rays without packets
 # (-DRANGECAST_NO_PACKETS, SIMD box tests), on one fixed workload
 # (tools/neon-workload.c: 9,800-triangle UV sphere, 2 VLP-16 scans, 1 thread).
+# Every build has projected scans off (RANGECAST_PROJECTED_SCANS): since
+# session 31 a map of at most one triangle per ray takes them instead of the
+# tree, and this counts the tree's traversals.
 #
 #   sh tools/neon-icount.sh            both targets
 #   sh tools/neon-icount.sh aarch64    only one (aarch64 | x86_64)
@@ -57,7 +60,7 @@ build() {
     cmake -S . -B "$dir" $tc -DCMAKE_BUILD_TYPE=Release \
         -DRANGECAST_BUILD_TOOLS=OFF -DRANGECAST_BUILD_TESTS=OFF -DRANGECAST_BUILD_SHARED=OFF \
         -DRANGECAST_WITH_EMBREE=OFF -DRANGECAST_WITH_VULKAN=OFF -DRANGECAST_WITH_THREADS=OFF \
-        "-DCMAKE_C_FLAGS=$cflags $vf" >/dev/null
+        -DRANGECAST_PROJECTED_SCANS=OFF "-DCMAKE_C_FLAGS=$cflags $vf" >/dev/null
     cmake --build "$dir" -j "$JOBS" >/dev/null
     # shellcheck disable=SC2086
     $cc -O2 $cflags -static -Iinclude tools/neon-workload.c "$dir/librangecast.a" -lm \
