@@ -16,6 +16,11 @@
 #endif
 #if defined(RC__PACKET_MESHES) && defined(__SSE2__)
 #include <emmintrin.h>
+#elif defined(RC__PACKET_MESHES) && defined(__ARM_NEON) && defined(__aarch64__)
+/* lanes_in_box in NEON lanes (AArch64 only: 32-bit ARM's NEON flushes
+ * subnormals, where box_hit's scalar operations would not) */
+#include "bvh/neon_ops.h"
+#define RC__LANES_IN_BOX_NEON 1
 #endif
 
 /* Slab test against a top-level node. Top-level boxes are few, so this is not
@@ -269,7 +274,7 @@ typedef struct lane_rows {
 
 static void lane_rows_fill(lane_rows *lr, const rc__ray *rays, uint32_t n)
 {
-#if defined(__SSE2__)
+#if defined(__SSE2__) || defined(RC__LANES_IN_BOX_NEON)
     uint32_t i, k;
     lr->finite = 1;
     for (i = 0; i < RC__PACKET_SIZE; ++i) {
@@ -328,6 +333,34 @@ static uint32_t lanes_in_box(const lane_rows *lr, const rc__ray *rays, const rc_
             }
         }
         out |= (uint32_t)_mm_movemask_ps(_mm_andnot_ps(reject, _mm_cmple_ps(t0, _mm_mul_ps(t1, scale)))) << g;
+    }
+#elif defined(RC__LANES_IN_BOX_NEON)
+    /* the same in NEON, with SSE2's min and max (neon_ops.h) */
+    const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE);
+    float tmax[RC__PACKET_SIZE];
+    (void)rays;
+    for (g = 0; g < n; ++g) tmax[g] = hits[g].t;
+    for (; g < RC__PACKET_SIZE; ++g) tmax[g] = -1.0f; /* lanes past n: never met */
+    for (g = 0; g < n; g += 4u) {
+        float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(tmax + g);
+        uint32x4_t reject = vdupq_n_u32(0u);
+        uint32_t k;
+        for (k = 0; k < 3u; ++k) {
+            const float32x4_t o = vld1q_f32(lr->org[k] + g), iv = vld1q_f32(lr->inv[k] + g);
+            const float32x4_t bmin = vdupq_n_f32(nd->bmin[k]), bmax = vdupq_n_f32(nd->bmax[k]);
+            const float32x4_t a = vmulq_f32(vsubq_f32(bmin, o), iv), b = vmulq_f32(vsubq_f32(bmax, o), iv);
+            const float32x4_t lo = rc__neon_min_sse(a, b), hi = rc__neon_max_sse(b, a);
+            if (lr->finite) {
+                t0 = rc__neon_max_sse(lo, t0);
+                t1 = rc__neon_min_sse(hi, t1);
+            } else {
+                const uint32x4_t nan = vmvnq_u32(vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b)));
+                reject = vorrq_u32(reject, vandq_u32(nan, vorrq_u32(vcltq_f32(o, bmin), vcgtq_f32(o, bmax))));
+                t0 = vbslq_f32(nan, t0, rc__neon_max_sse(lo, t0));
+                t1 = vbslq_f32(nan, t1, rc__neon_min_sse(hi, t1));
+            }
+        }
+        out |= rc__neon_bits(vbicq_u32(vcleq_f32(t0, vmulq_f32(t1, scale)), reject)) << g;
     }
 #else
     (void)lr;
