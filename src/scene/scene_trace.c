@@ -721,6 +721,59 @@ static void refine_two(const rc_scene *scene, const rc__hit *hits, const uint32_
     distance_lanes2(g.a, g.b, g.c, g.dir, world, hits, at, td);
 }
 
+/* rc__scene_hit_distance_d of two instances' hits at[0], at[1] in two
+ * lanes of doubles (SSE2, or NEON on AArch64: CPUs without AVX2 and ARM
+ * boards): each hit's corners turned by its instance's to_world, lane by
+ * lane rot_d's operations and the translation in their order, then
+ * distance_lanes2's: the same values. */
+#if defined(RC__HIT_DISTANCES_SSE2)
+#define RC__D2 __m128d
+#define RC__D2_OF(a, b) _mm_setr_pd(a, b)
+#define RC__D2_ADD(a, b) _mm_add_pd(a, b)
+#define RC__D2_MUL(a, b) _mm_mul_pd(a, b)
+#else
+#define RC__D2 float64x2_t
+#define RC__D2_OF(a, b) vsetq_lane_f64(b, vdupq_n_f64(a), 1)
+#define RC__D2_ADD(a, b) vaddq_f64(a, b)
+#define RC__D2_MUL(a, b) vmulq_f64(a, b)
+#endif
+static void refine_two_instanced(const rc_scene *scene, const rc__hit *hits, const uint32_t *at,
+                                 const rc__xformf *world, const float *directions, const uint32_t *idx, double *td)
+{
+    const float *p[2][3], *dir[2];
+    const double *r[2], *t[2];
+    RC__D2 q[3][3];
+    uint32_t i, c, k;
+    for (i = 0; i < 2u; ++i) {
+        const rc__xformf *x;
+        const rc__mesh *mesh = hit_mesh(scene, &hits[at[i]], &x);
+        const uint32_t *tri = hit_triangle(mesh, &hits[at[i]]);
+        for (c = 0; c < 3u; ++c) p[i][c] = mesh->vertices + (size_t)tri[c] * mesh->stride;
+        dir[i] = directions + (size_t)idx[at[i]] * 3u;
+        r[i] = x->rd;
+        t[i] = x->td;
+    }
+    /* q[c][k]: coordinate k of corner c in the scene's frame */
+    for (c = 0; c < 3u; ++c)
+        for (k = 0; k < 3u; ++k)
+            q[c][k] = RC__D2_ADD(
+                RC__D2_ADD(RC__D2_ADD(RC__D2_MUL(RC__D2_OF(r[0][3u * k], r[1][3u * k]),
+                                                 RC__D2_OF((double)p[0][c][0], (double)p[1][c][0])),
+                                      RC__D2_MUL(RC__D2_OF(r[0][3u * k + 1u], r[1][3u * k + 1u]),
+                                                 RC__D2_OF((double)p[0][c][1], (double)p[1][c][1]))),
+                           RC__D2_MUL(RC__D2_OF(r[0][3u * k + 2u], r[1][3u * k + 2u]),
+                                      RC__D2_OF((double)p[0][c][2], (double)p[1][c][2]))),
+                RC__D2_OF(t[0][k], t[1][k]));
+    distance_lanes2_corners(RC__D2_OF((double)dir[0][0], (double)dir[1][0]),
+                            RC__D2_OF((double)dir[0][1], (double)dir[1][1]),
+                            RC__D2_OF((double)dir[0][2], (double)dir[1][2]), q[0][0], q[0][1], q[0][2], q[1][0],
+                            q[1][1], q[1][2], q[2][0], q[2][1], q[2][2], world, hits, at, td);
+}
+#undef RC__D2
+#undef RC__D2_OF
+#undef RC__D2_ADD
+#undef RC__D2_MUL
+
 #if defined(RC__LEAF4_PAIR_AVX2)
 /* The three floats at p as a row (x, y, z, 0): the fourth element is masked
  * out, so the load never reaches past the end of the array (a masked-out
@@ -903,18 +956,16 @@ void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const
         if (!found[i]) {
             td[i] = 0.0;
         } else if (hits[i].inst != RC_INVALID_ID) {
+            /* instances' hits four at a time where the CPU has AVX2, else two */
+            inst[ki++] = i;
+            if (ki < group) continue;
 #if defined(RC__LEAF4_PAIR_AVX2)
-            /* instances' hits four at a time where the CPU has AVX2 */
-            if (group == 4u) {
-                inst[ki++] = i;
-                if (ki == 4u) {
-                    refine_four_instanced(scene, hits, inst, world, directions, idx, td);
-                    ki = 0;
-                }
-                continue;
-            }
+            if (group == 4u)
+                refine_four_instanced(scene, hits, inst, world, directions, idx, td);
+            else
 #endif
-            td[i] = rc__scene_hit_distance_d(scene, &hits[i], world, directions + (size_t)idx[i] * 3u, NULL);
+                refine_two_instanced(scene, hits, inst, world, directions, idx, td);
+            ki = 0;
         } else {
             own[k++] = i;
             if (k < group) continue;
@@ -927,8 +978,10 @@ void rc__scene_hit_distances_d(const rc_scene *scene, const rc__hit *hits, const
             k = 0;
         }
     }
-    for (i = 0; i < ki; ++i)
-        td[inst[i]] = rc__scene_hit_distance_d(scene, &hits[inst[i]], world, directions + (size_t)idx[inst[i]] * 3u, NULL);
+    for (i = 0; i + 1u < ki; i += 2u) refine_two_instanced(scene, hits, inst + i, world, directions, idx, td);
+    if (ki & 1u)
+        td[inst[ki - 1u]] = rc__scene_hit_distance_d(scene, &hits[inst[ki - 1u]], world,
+                                                     directions + (size_t)idx[inst[ki - 1u]] * 3u, NULL);
     for (i = 0; i + 1u < k; i += 2u) refine_two(scene, hits, own + i, world, directions, idx, td);
     if (k & 1u)
         td[own[k - 1u]] =
