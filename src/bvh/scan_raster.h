@@ -27,8 +27,10 @@
 /* Left out where CMake's RANGECAST_PROJECTED_SCANS is off (by default in
  * MinSizeRel builds, as the static core for small boards is built: they take
  * about 12 KB of text on aarch64, more than the core's size budget has left,
- * docs/benchmarks.md). Calls then take the packets, with the same results. */
-#if !defined(RANGECAST_NO_PROJECTED_SCANS)
+ * docs/benchmarks.md). Calls then take the packets, with the same results.
+ * Left out too in the single-rays benchmarking build (RANGECAST_NO_PACKETS,
+ * backend/bvh.c), which traces every ray through the tree. */
+#if !defined(RANGECAST_NO_PROJECTED_SCANS) && !defined(RANGECAST_NO_PACKETS)
 #define RC__PROJECTED_SCANS 1
 
 /* A spherical grid: ray (row i, column j) points along phi_min + i * phi_inc
