@@ -291,6 +291,50 @@ static void lane_rows_fill(lane_rows *lr, const rc__ray *rays, uint32_t n)
 #endif
 }
 
+#if defined(__SSE2__)
+/* box_hit's operations four lanes at a time: its selects are minps
+ * (a < b ? a : b) and maxps with the operands swapped (b > a ? b : a), its
+ * updates of t0 and t1 maxps and minps, so the answers are the same. NEON
+ * takes SSE2's min and max (neon_ops.h). */
+typedef __m128 lanes_f;
+typedef __m128 lanes_m;
+#define LANES_LOAD(p) _mm_loadu_ps(p)
+#define LANES_SET1(x) _mm_set1_ps(x)
+#define LANES_SUB(a, b) _mm_sub_ps(a, b)
+#define LANES_MUL(a, b) _mm_mul_ps(a, b)
+#define LANES_MIN(a, b) _mm_min_ps(a, b)
+#define LANES_MAX(a, b) _mm_max_ps(a, b)
+#define LANES_LT(a, b) _mm_cmplt_ps(a, b)
+#define LANES_GT(a, b) _mm_cmpgt_ps(a, b)
+#define LANES_LE(a, b) _mm_cmple_ps(a, b)
+#define LANES_UNORDERED(a, b) _mm_cmpunord_ps(a, b)
+#define LANES_NONE() _mm_setzero_ps()
+#define LANES_OR(m, k) _mm_or_ps(m, k)
+#define LANES_AND(m, k) _mm_and_ps(m, k)
+#define LANES_ANDNOT(m, k) _mm_andnot_ps(m, k) /* ~m & k */
+#define LANES_SELECT(m, a, b) _mm_or_ps(_mm_and_ps(m, a), _mm_andnot_ps(m, b))
+#define LANES_BITS(m) ((uint32_t)_mm_movemask_ps(m))
+#elif defined(RC__LANES_IN_BOX_NEON)
+typedef float32x4_t lanes_f;
+typedef uint32x4_t lanes_m;
+#define LANES_LOAD(p) vld1q_f32(p)
+#define LANES_SET1(x) vdupq_n_f32(x)
+#define LANES_SUB(a, b) vsubq_f32(a, b)
+#define LANES_MUL(a, b) vmulq_f32(a, b)
+#define LANES_MIN(a, b) rc__neon_min_sse(a, b)
+#define LANES_MAX(a, b) rc__neon_max_sse(a, b)
+#define LANES_LT(a, b) vcltq_f32(a, b)
+#define LANES_GT(a, b) vcgtq_f32(a, b)
+#define LANES_LE(a, b) vcleq_f32(a, b)
+#define LANES_UNORDERED(a, b) vmvnq_u32(vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b)))
+#define LANES_NONE() vdupq_n_u32(0u)
+#define LANES_OR(m, k) vorrq_u32(m, k)
+#define LANES_AND(m, k) vandq_u32(m, k)
+#define LANES_ANDNOT(m, k) vbicq_u32(k, m) /* ~m & k */
+#define LANES_SELECT(m, a, b) vbslq_f32(m, a, b)
+#define LANES_BITS(m) rc__neon_bits(m)
+#endif
+
 /* The lanes of the packet (rays[0 .. n), at most RC__PACKET_SIZE, as rows
  * lr) whose own ray passes box_hit against nd's box within its hit so far:
  * the same test the single-ray walk gives each ray before an instance, so
@@ -301,66 +345,35 @@ static uint32_t lanes_in_box(const lane_rows *lr, const rc__ray *rays, const rc_
                              const rc__bvh_node *nd)
 {
     uint32_t out = 0, g;
-#if defined(__SSE2__)
-    /* box_hit four lanes at a time, the same operations: its selects are
-     * minps (a < b ? a : b) and maxps with the operands swapped
-     * (b > a ? b : a), its updates of t0 and t1 maxps and minps, so the
-     * answers are the same */
-    const __m128 scale = _mm_set1_ps(RC__SLAB_FAR_SCALE);
+#if defined(LANES_LOAD)
+    const lanes_f scale = LANES_SET1(RC__SLAB_FAR_SCALE);
     float tmax[RC__PACKET_SIZE];
     (void)rays;
     for (g = 0; g < n; ++g) tmax[g] = hits[g].t;
     for (; g < RC__PACKET_SIZE; ++g) tmax[g] = -1.0f; /* lanes past n: never met */
     for (g = 0; g < n; g += 4u) {
-        __m128 t0 = _mm_setzero_ps(), t1 = _mm_loadu_ps(tmax + g), reject = _mm_setzero_ps();
+        lanes_f t0 = LANES_SET1(0.0f), t1 = LANES_LOAD(tmax + g);
+        lanes_m reject = LANES_NONE();
         uint32_t k;
         for (k = 0; k < 3u; ++k) {
-            const __m128 o = _mm_loadu_ps(lr->org[k] + g), iv = _mm_loadu_ps(lr->inv[k] + g);
-            const __m128 bmin = _mm_set1_ps(nd->bmin[k]), bmax = _mm_set1_ps(nd->bmax[k]);
-            const __m128 a = _mm_mul_ps(_mm_sub_ps(bmin, o), iv), b = _mm_mul_ps(_mm_sub_ps(bmax, o), iv);
-            const __m128 lo = _mm_min_ps(a, b), hi = _mm_max_ps(b, a);
+            const lanes_f o = LANES_LOAD(lr->org[k] + g), iv = LANES_LOAD(lr->inv[k] + g);
+            const lanes_f bmin = LANES_SET1(nd->bmin[k]), bmax = LANES_SET1(nd->bmax[k]);
+            const lanes_f a = LANES_MUL(LANES_SUB(bmin, o), iv), b = LANES_MUL(LANES_SUB(bmax, o), iv);
+            const lanes_f lo = LANES_MIN(a, b), hi = LANES_MAX(b, a);
             if (lr->finite) { /* (a constant over the loop) */
-                t0 = _mm_max_ps(lo, t0);
-                t1 = _mm_min_ps(hi, t1);
+                t0 = LANES_MAX(lo, t0);
+                t1 = LANES_MIN(hi, t1);
             } else {
                 /* 0 * inf: the origin on the slab's plane, the ray parallel
                  * to it; outside the slab it misses, inside this axis
                  * imposes nothing */
-                const __m128 nan = _mm_cmpunord_ps(a, b);
-                reject = _mm_or_ps(reject, _mm_and_ps(nan, _mm_or_ps(_mm_cmplt_ps(o, bmin), _mm_cmpgt_ps(o, bmax))));
-                t0 = _mm_or_ps(_mm_and_ps(nan, t0), _mm_andnot_ps(nan, _mm_max_ps(lo, t0)));
-                t1 = _mm_or_ps(_mm_and_ps(nan, t1), _mm_andnot_ps(nan, _mm_min_ps(hi, t1)));
+                const lanes_m nan = LANES_UNORDERED(a, b);
+                reject = LANES_OR(reject, LANES_AND(nan, LANES_OR(LANES_LT(o, bmin), LANES_GT(o, bmax))));
+                t0 = LANES_SELECT(nan, t0, LANES_MAX(lo, t0));
+                t1 = LANES_SELECT(nan, t1, LANES_MIN(hi, t1));
             }
         }
-        out |= (uint32_t)_mm_movemask_ps(_mm_andnot_ps(reject, _mm_cmple_ps(t0, _mm_mul_ps(t1, scale)))) << g;
-    }
-#elif defined(RC__LANES_IN_BOX_NEON)
-    /* the same in NEON, with SSE2's min and max (neon_ops.h) */
-    const float32x4_t scale = vdupq_n_f32(RC__SLAB_FAR_SCALE);
-    float tmax[RC__PACKET_SIZE];
-    (void)rays;
-    for (g = 0; g < n; ++g) tmax[g] = hits[g].t;
-    for (; g < RC__PACKET_SIZE; ++g) tmax[g] = -1.0f; /* lanes past n: never met */
-    for (g = 0; g < n; g += 4u) {
-        float32x4_t t0 = vdupq_n_f32(0.0f), t1 = vld1q_f32(tmax + g);
-        uint32x4_t reject = vdupq_n_u32(0u);
-        uint32_t k;
-        for (k = 0; k < 3u; ++k) {
-            const float32x4_t o = vld1q_f32(lr->org[k] + g), iv = vld1q_f32(lr->inv[k] + g);
-            const float32x4_t bmin = vdupq_n_f32(nd->bmin[k]), bmax = vdupq_n_f32(nd->bmax[k]);
-            const float32x4_t a = vmulq_f32(vsubq_f32(bmin, o), iv), b = vmulq_f32(vsubq_f32(bmax, o), iv);
-            const float32x4_t lo = rc__neon_min_sse(a, b), hi = rc__neon_max_sse(b, a);
-            if (lr->finite) {
-                t0 = rc__neon_max_sse(lo, t0);
-                t1 = rc__neon_min_sse(hi, t1);
-            } else {
-                const uint32x4_t nan = vmvnq_u32(vandq_u32(vceqq_f32(a, a), vceqq_f32(b, b)));
-                reject = vorrq_u32(reject, vandq_u32(nan, vorrq_u32(vcltq_f32(o, bmin), vcgtq_f32(o, bmax))));
-                t0 = vbslq_f32(nan, t0, rc__neon_max_sse(lo, t0));
-                t1 = vbslq_f32(nan, t1, rc__neon_min_sse(hi, t1));
-            }
-        }
-        out |= rc__neon_bits(vbicq_u32(vcleq_f32(t0, vmulq_f32(t1, scale)), reject)) << g;
+        out |= LANES_BITS(LANES_ANDNOT(reject, LANES_LE(t0, LANES_MUL(t1, scale)))) << g;
     }
 #else
     (void)lr;
