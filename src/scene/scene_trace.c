@@ -579,6 +579,19 @@ static RC__FORCE_INLINE void rot_d(const double r[9], double px, double py, doub
  * 16-byte loads of values it had just stored 8 bytes at a time, and the CPU
  * cannot forward two stores into one load (a stall of a dozen cycles or
  * more, which made this function 18% of the time on a 1k map). */
+/* How far (a fraction of the traversal's t) the refinement takes a hit
+ * without checking the crossing against the triangle
+ * (rc__scene_hit_distance_d; the lanes of hit_distance_lanes.h leave
+ * further ones to it) */
+#define RC__REFINE_NEAR (1.0 / 4096.0)
+
+/* The depth of corner (x, y, z) along d from o */
+static double corner_depth(double x, double y, double z, double ox, double oy, double oz, double dx, double dy,
+                           double dz)
+{
+    return ((x - ox) * dx + (y - oy) * dy) + (z - oz) * dz;
+}
+
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
                                 const float dir_s[3], const float *org_s)
 {
@@ -617,7 +630,32 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
     dn = nx * dx + ny * dy + nz * dz;
     w = nx * (ax - ox) + ny * (ay - oy) + nz * (az - oz);
     if (dn == 0.0 || !isfinite(w / dn)) return hit->t;
-    return w / dn;
+    {
+        /* Rounding moves a hit's t by a few ulps, some hundreds for needles
+         * or rays moved through far instances: a crossing that near is the
+         * better distance (the lanes decide those alone). One further off
+         * is checked against the triangle: a crossing on it lies between
+         * its corners' depths along the ray, and so does the float test's t
+         * (it weighs them). A crossing far outside that band (by more than
+         * its width, and a part in 2^20) is off the triangle: the ray runs
+         * along its plane, and the float test found the hit by rounding.
+         * The traversal's t stays then, as where the ray is parallel; the
+         * crossing could be anywhere, even past the range max, which would
+         * read as no return and hide the hit behind that the float hit
+         * culled (fuzz_trace, session 44). Within the band the crossing is
+         * the better distance, grazing rays' too. */
+        const double q = w / dn, t = (double)hit->t;
+        double da, db, dc, lo, hi, slack;
+        if (!(fabs(q - t) > RC__REFINE_NEAR * t)) return q;
+        da = corner_depth(ax, ay, az, ox, oy, oz, dx, dy, dz);
+        db = corner_depth(bx, by, bz, ox, oy, oz, dx, dy, dz);
+        dc = corner_depth(cx, cy, cz, ox, oy, oz, dx, dy, dz);
+        lo = da < db ? (da < dc ? da : dc) : (db < dc ? db : dc);
+        hi = da > db ? (da > dc ? da : dc) : (db > dc ? db : dc);
+        slack = (hi - lo) + fabs(q) * (1.0 / 1048576.0);
+        if (q < lo - slack || q > hi + slack) return hit->t;
+        return q;
+    }
 }
 
 #if defined(RC__HIT_DISTANCES_LANES)
@@ -637,6 +675,9 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
 #define RC__HD_ODD(dn, q)                                                                                            \
     _mm_movemask_pd(_mm_or_pd(_mm_cmpeq_pd(dn, _mm_setzero_pd()),                                                   \
                               _mm_cmpnlt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), q), _mm_set1_pd(INFINITY))))
+#define RC__HD_FAR(q, t, c)                                                                                          \
+    _mm_movemask_pd(_mm_cmpgt_pd(_mm_andnot_pd(_mm_set1_pd(-0.0), _mm_sub_pd(q, t)), _mm_mul_pd(_mm_set1_pd(c), t)))
+#define RC__HD_HIT_T(h, at) _mm_setr_pd((double)(h)[(at)[0]].t, (double)(h)[(at)[1]].t)
 #define RC__HD_STORE(p, v) _mm_storeu_pd(p, v)
 #include "scene/hit_distance_lanes.h"
 #else
@@ -655,12 +696,19 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
 #define RC__HD_GATHER(p, k) vsetq_lane_f64((double)(p)[1][k], vdupq_n_f64((double)(p)[0][k]), 1)
 /* not |q| < inf: inf or NaN */
 #define RC__HD_ODD(dn, q) rc__hd_odd_neon(dn, q)
+#define RC__HD_FAR(q, t, c) rc__hd_far_neon(q, t, c)
+#define RC__HD_HIT_T(h, at) vsetq_lane_f64((double)(h)[(at)[1]].t, vdupq_n_f64((double)(h)[(at)[0]].t), 1)
 #define RC__HD_STORE(p, v) vst1q_f64(p, v)
 static inline int rc__hd_odd_neon(float64x2_t dn, float64x2_t q)
 {
     const uint64x2_t odd = vorrq_u64(vceqq_f64(dn, vdupq_n_f64(0.0)),
                                      veorq_u64(vcltq_f64(vabsq_f64(q), vdupq_n_f64(INFINITY)), vdupq_n_u64(~0ull)));
     return (int)((vgetq_lane_u64(odd, 0) & 1u) | (vgetq_lane_u64(odd, 1) & 2u));
+}
+static inline int rc__hd_far_neon(float64x2_t q, float64x2_t t, double c)
+{
+    const uint64x2_t m = vcgtq_f64(vabsq_f64(vsubq_f64(q, t)), vmulq_f64(vdupq_n_f64(c), t));
+    return (int)((vgetq_lane_u64(m, 0) & 1u) | (vgetq_lane_u64(m, 1) & 2u));
 }
 #include "scene/hit_distance_lanes.h"
 #endif
@@ -682,6 +730,11 @@ static inline int rc__hd_odd_neon(float64x2_t dn, float64x2_t q)
     _mm256_movemask_pd(_mm256_or_pd(_mm256_cmp_pd(dn, _mm256_setzero_pd(), _CMP_EQ_OQ),                           \
                                     _mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), q),                       \
                                                   _mm256_set1_pd(INFINITY), _CMP_NLT_UQ)))
+#define RC__HD_FAR(q, t, c)                                                                                          \
+    _mm256_movemask_pd(_mm256_cmp_pd(_mm256_andnot_pd(_mm256_set1_pd(-0.0), _mm256_sub_pd(q, t)),                  \
+                                     _mm256_mul_pd(_mm256_set1_pd(c), t), _CMP_GT_OQ))
+#define RC__HD_HIT_T(h, at)                                                                                          \
+    _mm256_cvtps_pd(_mm_setr_ps((h)[(at)[0]].t, (h)[(at)[1]].t, (h)[(at)[2]].t, (h)[(at)[3]].t))
 #define RC__HD_STORE(p, v) _mm256_storeu_pd(p, v)
 #include "scene/hit_distance_lanes.h"
 #endif
@@ -725,13 +778,26 @@ static RC__FORCE_INLINE void group_fill(const rc_scene *scene, const rc__hit *hi
     }
 }
 
+/* The lanes far (bits of at[]) whose quotient lies further from the
+ * traversal's t than the lanes decide (hit_distance_lanes.h), one by one */
+static void refine_far(const rc_scene *scene, const rc__hit *hits, const uint32_t *at, int far, const rc__xformf *world,
+                       const float *directions, const uint32_t *idx, double *td)
+{
+    for (; far; far &= far - 1) {
+        const uint32_t i = at[rc__lowest_bit((uint32_t)far)];
+        td[i] = rc__scene_hit_distance_d(scene, &hits[i], world, directions + (size_t)idx[i] * 3u, NULL);
+    }
+}
+
 /* rc__scene_hit_distance_d of hits at[0], at[1] */
 static void refine_two(const rc_scene *scene, const rc__hit *hits, const uint32_t *at, const rc__xformf *world,
                        const float *directions, const uint32_t *idx, double *td)
 {
     hit_group g;
+    int far;
     group_fill(scene, hits, at, 2u, directions, idx, &g);
-    distance_lanes2(g.a, g.b, g.c, g.dir, world, hits, at, td);
+    far = distance_lanes2(g.a, g.b, g.c, g.dir, world, hits, at, td);
+    if (RC__UNLIKELY(far)) refine_far(scene, hits, at, far, world, directions, idx, td);
 }
 
 /* rc__scene_hit_distance_d of two instances' hits at[0], at[1] in two
@@ -757,6 +823,7 @@ static void refine_two_instanced(const rc_scene *scene, const rc__hit *hits, con
     const double *r[2], *t[2];
     RC__D2 q[3][3];
     uint32_t i, c, k;
+    int far;
     for (i = 0; i < 2u; ++i) {
         const rc__xformf *x;
         const rc__mesh *mesh = hit_mesh(scene, &hits[at[i]], &x);
@@ -777,10 +844,11 @@ static void refine_two_instanced(const rc_scene *scene, const rc__hit *hits, con
                            RC__D2_MUL(RC__D2_OF(r[0][3u * k + 2u], r[1][3u * k + 2u]),
                                       RC__D2_OF((double)p[0][c][2], (double)p[1][c][2]))),
                 RC__D2_OF(t[0][k], t[1][k]));
-    distance_lanes2_corners(RC__D2_OF((double)dir[0][0], (double)dir[1][0]),
-                            RC__D2_OF((double)dir[0][1], (double)dir[1][1]),
-                            RC__D2_OF((double)dir[0][2], (double)dir[1][2]), q[0][0], q[0][1], q[0][2], q[1][0],
-                            q[1][1], q[1][2], q[2][0], q[2][1], q[2][2], world, hits, at, td);
+    far = distance_lanes2_corners(RC__D2_OF((double)dir[0][0], (double)dir[1][0]),
+                                  RC__D2_OF((double)dir[0][1], (double)dir[1][1]),
+                                  RC__D2_OF((double)dir[0][2], (double)dir[1][2]), q[0][0], q[0][1], q[0][2], q[1][0],
+                                  q[1][1], q[1][2], q[2][0], q[2][1], q[2][2], world, hits, at, td);
+    if (RC__UNLIKELY(far)) refine_far(scene, hits, at, far, world, directions, idx, td);
 }
 #undef RC__D2
 #undef RC__D2_OF
@@ -813,7 +881,7 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void columns4(__m128 r0,
  * went through the stack and were read three times each (100k sphere: 322
  * instructions a call). The values are distance_lanes4's: the same
  * operations on the same coordinates. */
-static RC__FORCE_INLINE __attribute__((target("avx2"))) void refine_four_rows(const rc__mesh *const mesh[4],
+static RC__FORCE_INLINE __attribute__((target("avx2"))) int refine_four_rows(const rc__mesh *const mesh[4],
                                                                               const rc__hit *hits, const uint32_t *at,
                                                                               const rc__xformf *world,
                                                                               const float *directions,
@@ -835,7 +903,7 @@ static RC__FORCE_INLINE __attribute__((target("avx2"))) void refine_four_rows(co
     columns4(ra[0], ra[1], ra[2], ra[3], &ax, &ay, &az);
     columns4(rb[0], rb[1], rb[2], rb[3], &bx, &by, &bz);
     columns4(rc[0], rc[1], rc[2], rc[3], &cx, &cy, &cz);
-    distance_lanes4_corners(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz, world, hits, at, td);
+    return distance_lanes4_corners(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz, world, hits, at, td);
 }
 
 /* The 4 x 4 doubles rows r0 .. r3 as columns (c[j] lane i = r_i[j]) */
@@ -864,6 +932,7 @@ static __attribute__((target("avx2"))) void refine_four_instanced(const rc_scene
     __m128 ra[4], rb[4], rc[4], rd[4];
     __m256d q[4][3], m[12], px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz;
     uint32_t i;
+    int far;
     for (i = 0; i < 4u; ++i) {
         const rc__hit *h = &hits[at[i]];
         const rc__xformf *x;
@@ -891,10 +960,11 @@ static __attribute__((target("avx2"))) void refine_four_instanced(const rc_scene
     _mm256_add_pd(_mm256_add_pd(_mm256_add_pd(_mm256_mul_pd(m[3 * (k)], px_), _mm256_mul_pd(m[3 * (k) + 1], py_)), \
                                 _mm256_mul_pd(m[3 * (k) + 2], pz_)),                                               \
                   m[9 + (k)])
-    distance_lanes4_corners(px, py, pz, RC__TURN(ax, ay, az, 0), RC__TURN(ax, ay, az, 1), RC__TURN(ax, ay, az, 2),
-                            RC__TURN(bx, by, bz, 0), RC__TURN(bx, by, bz, 1), RC__TURN(bx, by, bz, 2),
-                            RC__TURN(cx, cy, cz, 0), RC__TURN(cx, cy, cz, 1), RC__TURN(cx, cy, cz, 2), world, hits,
-                            at, td);
+    far = distance_lanes4_corners(px, py, pz, RC__TURN(ax, ay, az, 0), RC__TURN(ax, ay, az, 1),
+                                  RC__TURN(ax, ay, az, 2), RC__TURN(bx, by, bz, 0), RC__TURN(bx, by, bz, 1),
+                                  RC__TURN(bx, by, bz, 2), RC__TURN(cx, cy, cz, 0), RC__TURN(cx, cy, cz, 1),
+                                  RC__TURN(cx, cy, cz, 2), world, hits, at, td);
+    if (RC__UNLIKELY(far)) refine_far(scene, hits, at, far, world, directions, idx, td);
 #undef RC__TURN
 }
 
@@ -909,6 +979,7 @@ static __attribute__((target("avx2"))) int refine_rows_tile(const rc_scene *scen
     const rc__mesh *one = &scene->geoms[0].mesh;
     const rc__mesh *const meshes[4] = {one, one, one, one};
     uint32_t own[4], k = 0, i;
+    int far;
     for (i = 0; i < n; ++i) {
         td[i] = 0.0;
         own[k] = i;
@@ -917,7 +988,8 @@ static __attribute__((target("avx2"))) int refine_rows_tile(const rc_scene *scen
         if ((hits[own[0]].slot == RC_INVALID_ID) | (hits[own[1]].slot == RC_INVALID_ID) |
             (hits[own[2]].slot == RC_INVALID_ID) | (hits[own[3]].slot == RC_INVALID_ID))
             return 0;
-        refine_four_rows(meshes, hits, own, world, directions, idx, td);
+        far = refine_four_rows(meshes, hits, own, world, directions, idx, td);
+        if (RC__UNLIKELY(far)) refine_far(scene, hits, own, far, world, directions, idx, td);
         k = 0;
     }
     for (i = 0; i < k; ++i)
@@ -935,17 +1007,19 @@ static __attribute__((target("avx2"))) void refine_four(const rc_scene *scene, c
 {
     const rc__mesh *meshes[4];
     uint32_t i, rows = 1;
+    int far;
     hit_group g;
     for (i = 0; i < 4u; ++i) {
         meshes[i] = &scene->geoms[hits[at[i]].geom].mesh;
         rows &= (meshes[i]->leaf_tris != NULL) & (hits[at[i]].slot != RC_INVALID_ID);
     }
     if (rows) {
-        refine_four_rows(meshes, hits, at, world, directions, idx, td);
-        return;
+        far = refine_four_rows(meshes, hits, at, world, directions, idx, td);
+    } else {
+        group_fill(scene, hits, at, 4u, directions, idx, &g);
+        far = distance_lanes4(g.a, g.b, g.c, g.dir, world, hits, at, td);
     }
-    group_fill(scene, hits, at, 4u, directions, idx, &g);
-    distance_lanes4(g.a, g.b, g.c, g.dir, world, hits, at, td);
+    if (RC__UNLIKELY(far)) refine_far(scene, hits, at, far, world, directions, idx, td);
 }
 #endif
 
