@@ -575,10 +575,6 @@ static RC__FORCE_INLINE void rot_d(const double r[9], double px, double py, doub
     *z = r[6] * px + r[7] * py + r[8] * pz;
 }
 
-/* Written with scalar locals, not arrays: gcc pairs array elements into
- * 16-byte loads of values it had just stored 8 bytes at a time, and the CPU
- * cannot forward two stores into one load (a stall of a dozen cycles or
- * more, which made this function 18% of the time on a 1k map). */
 /* How far (a fraction of the traversal's t) the refinement takes a hit
  * without checking the crossing against the triangle
  * (rc__scene_hit_distance_d; the lanes of hit_distance_lanes.h leave
@@ -592,6 +588,10 @@ static double corner_depth(double x, double y, double z, double ox, double oy, d
     return ((x - ox) * dx + (y - oy) * dy) + (z - oz) * dz;
 }
 
+/* Written with scalar locals, not arrays: gcc pairs array elements into
+ * 16-byte loads of values it had just stored 8 bytes at a time, and the CPU
+ * cannot forward two stores into one load (a stall of a dozen cycles or
+ * more, which made this function 18% of the time on a 1k map). */
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
                                 const float dir_s[3], const float *org_s)
 {
