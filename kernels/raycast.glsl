@@ -874,16 +874,14 @@ float refine_t(Hit h, uint pose, vec3 ds, vec3 os)
     precise double td = w / dn;
     if (isinf(td) || isnan(td)) return h.t;
     /* a crossing further from t than rounding takes a hit
-     * (RC__REFINE_NEAR) and far outside the band of the corners' depths
-     * along the ray lies off the triangle (the ray runs along its plane):
-     * the traversal's t stays (rc__scene_hit_distance_d) */
+     * (RC__REFINE_NEAR) and far from the corners' depths along the ray
+     * lies off the triangle (the ray runs along its plane): the traversal's
+     * t stays (rc__scene_hit_distance_d) */
     if (abs(td - double(h.t)) > double(h.t) * (1.0lf / 4096.0lf)) {
         precise double da = ((v[0].x - od[0]) * dd[0] + (v[0].y - od[1]) * dd[1]) + (v[0].z - od[2]) * dd[2];
-        precise double db = ((v[1].x - od[0]) * dd[0] + (v[1].y - od[1]) * dd[1]) + (v[1].z - od[2]) * dd[2];
-        precise double dc = ((v[2].x - od[0]) * dd[0] + (v[2].y - od[1]) * dd[1]) + (v[2].z - od[2]) * dd[2];
-        double lo = min(min(da, db), dc), hi = max(max(da, db), dc);
-        precise double slack = (hi - lo) + abs(td) * (1.0lf / 1048576.0lf);
-        if (td < lo - slack || td > hi + slack) return h.t;
+        precise double sb = abs((e1x * dd[0] + e1y * dd[1]) + e1z * dd[2]);
+        precise double sc = abs((e2x * dd[0] + e2y * dd[1]) + e2z * dd[2]);
+        if (abs(td - da) > 2.0lf * (sb + sc) + double(h.t) * (1.0lf / 4096.0lf)) return h.t;
     }
     /* the plane's distance is the better one; a non-positive value (origin
      * on the plane) keeps the traversal's t */

@@ -7,7 +7,7 @@
  * triangle. The refinement used to take that crossing: past the range max,
  * the hit read as no return, and the wall behind it, which the hit had
  * culled, was lost too. It now keeps the traversal's t where the crossing
- * lies outside the band of the triangle's corners' depths along the ray
+ * lies far from the triangle's corners' depths along the ray
  * (rc__scene_hit_distance_d), so the hit stands at the float test's t. Checked
  * with ranges alone (a tile's hits refined in groups of lanes) and with
  * every attribute (one hit at a time), for one ray and for five (a group of

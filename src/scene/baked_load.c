@@ -196,8 +196,8 @@ static rc_status check_tree_order(rc_context *ctx, uint32_t g, const rc__baked_g
     for (;;) {
         uint32_t kids[4], k = 0, c;
         RC_RETURN_IF(ctx, node != expect, CORRUPT,
-                     "baked map: geometry %u: the tree reaches node %u where a depth-first walk is at node %u (a "
-                     "baked tree holds each node once, in the order a build writes them)",
+                     "baked map: geometry %u: the tree reaches node %u where a depth-first walk is at node %u "
+                     "(each node once, in the order a build writes them)",
                      (unsigned)g, (unsigned)node, (unsigned)expect);
         ++expect;
         for (c = 0; c < 4u; ++c)

@@ -134,9 +134,9 @@ void rc__scene_intersect_packet_instances(const rc_scene *scene, const rc__ray *
  * scan's world transform in double) against the plane of the hit triangle
  * (through its instance's transform in double). Returns hit->t where the ray
  * is parallel to the plane, and where it crosses the plane far off the
- * triangle (more than 1/4096 of t away, and beyond the band of its corners'
- * depths along the ray by more than the band's width: a ray along the
- * plane, hit by the float test's rounding; docs/architecture.md). */
+ * triangle (more than 1/4096 of t away, and further from corner a's depth
+ * along the ray than twice the other corners' spread from it: a ray along
+ * the plane, hit by the float test's rounding; docs/architecture.md). */
 double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const rc__xformf *world,
                                 const float dir_s[3], const float *org_s);
 

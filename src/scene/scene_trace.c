@@ -581,13 +581,6 @@ static RC__FORCE_INLINE void rot_d(const double r[9], double px, double py, doub
  * further ones to it) */
 #define RC__REFINE_NEAR (1.0 / 4096.0)
 
-/* The depth of corner (x, y, z) along d from o */
-static double corner_depth(double x, double y, double z, double ox, double oy, double oz, double dx, double dy,
-                           double dz)
-{
-    return ((x - ox) * dx + (y - oy) * dy) + (z - oz) * dz;
-}
-
 /* Written with scalar locals, not arrays: gcc pairs array elements into
  * 16-byte loads of values it had just stored 8 bytes at a time, and the CPU
  * cannot forward two stores into one load (a stall of a dozen cycles or
@@ -629,6 +622,7 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
     nz = e1x * e2y - e1y * e2x;
     dn = nx * dx + ny * dy + nz * dz;
     w = nx * (ax - ox) + ny * (ay - oy) + nz * (az - oz);
+    /* a ray parallel to the plane keeps the traversal's t */
     if (dn == 0.0 || !isfinite(w / dn)) return hit->t;
     {
         /* Rounding moves a hit's t by a few ulps, some hundreds for needles
@@ -636,25 +630,22 @@ double rc__scene_hit_distance_d(const rc_scene *scene, const rc__hit *hit, const
          * better distance (the lanes decide those alone). One further off
          * is checked against the triangle: a crossing on it lies between
          * its corners' depths along the ray, and so does the float test's t
-         * (it weighs them). A crossing far outside that band (by more than
-         * its width, and a part in 2^20) is off the triangle: the ray runs
-         * along its plane, and the float test found the hit by rounding.
-         * The traversal's t stays then, as where the ray is parallel; the
+         * (it weighs them), so within the spread of the other corners'
+         * depths from corner a's (twice over, and the same 1/4096 of t for
+         * rounding) the crossing is the better distance, grazing rays' too.
+         * One further off is off the triangle: the ray runs along its
+         * plane, and the float test found the hit by rounding. The
+         * traversal's t stays then, as where the ray is parallel; the
          * crossing could be anywhere, even past the range max, which would
          * read as no return and hide the hit behind that the float hit
-         * culled (fuzz_trace, session 44). Within the band the crossing is
-         * the better distance, grazing rays' too. */
-        const double q = w / dn, t = (double)hit->t;
-        double da, db, dc, lo, hi, slack;
-        if (!(fabs(q - t) > RC__REFINE_NEAR * t)) return q;
-        da = corner_depth(ax, ay, az, ox, oy, oz, dx, dy, dz);
-        db = corner_depth(bx, by, bz, ox, oy, oz, dx, dy, dz);
-        dc = corner_depth(cx, cy, cz, ox, oy, oz, dx, dy, dz);
-        lo = da < db ? (da < dc ? da : dc) : (db < dc ? db : dc);
-        hi = da > db ? (da > dc ? da : dc) : (db > dc ? db : dc);
-        slack = (hi - lo) + fabs(q) * (1.0 / 1048576.0);
-        if (q < lo - slack || q > hi + slack) return hit->t;
-        return q;
+         * culled (fuzz_trace, session 44). */
+        const double q = w / dn, t = hit->t, near = RC__REFINE_NEAR * t;
+        return fabs(q - t) > near && fabs(q - (((ax - ox) * dx + (ay - oy) * dy) + (az - oz) * dz)) >
+                                         2.0 * (fabs((e1x * dx + e1y * dy) + e1z * dz) +
+                                                fabs((e2x * dx + e2y * dy) + e2z * dz)) +
+                                             near
+                   ? t
+                   : q;
     }
 }
 
