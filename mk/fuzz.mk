@@ -11,9 +11,10 @@
 #               finding into tests/fuzz/corpus/<name> once it is fixed: every
 #               build replays that corpus as the test fuzz_<name>_replay.
 #
-# trace's inputs grow to 2800 bytes (256 triangles, 64 rays with their own
-# origins, four instances, a grid sensor): libFuzzer would otherwise cap them
-# at the corpus' largest seed.
+# trace's inputs grow to 5200 bytes (256 triangles, 64 rays with their own
+# origins, four instances, a grid sensor, then a dynamic map's new vertices
+# and placements): libFuzzer would otherwise cap them at the corpus' largest
+# seed.
 # Installs clang, its libFuzzer runtime and libcjson-dev (tools/setup-deps.sh
 # fuzz), or prints the apt-get line when not root.
 # Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace).
@@ -36,7 +37,7 @@ fuzz:
 		if [ ! -x $$exe ]; then echo "fuzz: no fuzz_$$t in this build (fuzz_ouster needs libcjson-dev)"; continue; fi; \
 		mkdir -p $(FUZZ_BUILD)/corpus/$$t; \
 		echo "fuzz: $$t for $(FUZZ_SECONDS) s"; \
-		max_len=; [ $$t = trace ] && max_len=-max_len=2800; \
+		max_len=; [ $$t = trace ] && max_len=-max_len=5200; \
 		UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 $$exe -max_total_time=$(FUZZ_SECONDS) -timeout=10 $$max_len \
 			-rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix=$(FUZZ_BUILD)/findings/$$t- \
 			$(FUZZ_BUILD)/corpus/$$t tests/fuzz/corpus/$$t 2>$(FUZZ_BUILD)/fuzz_$$t.log || \

@@ -9,7 +9,9 @@
  * from 33), and the scene may hold up to
  * four instances of a scene of those meshes (turned, scaled, mirrored: the
  * two-level tree), the meshes themselves beside them or not. The traversals that take turns on
- * large maps can be forced. Promised: every ray's hit, and the triangle,
+ * large maps can be forced, and the scene may then change and be traced
+ * again (dynamic maps: meshes, referenced, get new vertices and a refit;
+ * instances move). Promised: every ray's hit, and the triangle,
  * mesh and instance it names, are exactly those of testing every triangle of
  * every mesh and instance with the same watertight test and tie rule, one by
  * one (instances with the ray turned into their frame as the library turns
@@ -210,14 +212,16 @@ static int library_is(const rc_scene *scene, const float *verts, const mesh_spli
            beyond_slack(scene, verts, ms, org, dir, h, geom, prim, inst);
 }
 
-/* Adds the split meshes to scene (copied, so the arrays can be reused). */
-static void add_meshes(rc_scene *scene, const float *verts, const uint32_t *indices, const mesh_split *ms)
+/* Adds the split meshes to scene: copied, or referenced where the input
+ * moves them later (the arrays then stay put until the scene goes). */
+static void add_meshes(rc_scene *scene, const float *verts, const uint32_t *indices, const mesh_split *ms,
+                       int referenced)
 {
     uint32_t m, geom;
     for (m = 0; m < ms->count; ++m) {
         rc_mesh_desc md = rc_mesh_desc_default();
         const uint32_t n = ms->first[m + 1] - ms->first[m];
-        md.flags = RC_MESH_COPY;
+        md.flags = referenced ? 0u : RC_MESH_COPY;
         md.vertices = verts + 9u * ms->first[m];
         md.vertex_count = 3u * n;
         md.indices = indices;
@@ -285,93 +289,48 @@ static float scale_of(uint8_t b)
     return scales[b & 7u];
 }
 
-int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+/* An instance's placement from the input: a point on the grid, a unit
+ * quaternion, a scale an axis. */
+static void placement(reader *r, float scale, rc_pose *transform, float scales[3])
 {
-    static float verts[MAX_TRIS * 9u], origins[MAX_RAYS * 3u], dirs[MAX_RAYS * 3u], ranges[MAX_RAYS];
-    static float points[MAX_RAYS * 3u], normals[MAX_RAYS * 3u];
-    static uint32_t indices[MAX_TRIS * 3u], prims[MAX_RAYS], geoms[MAX_RAYS], insts[MAX_RAYS];
+    float q[4], n2 = 0.0f;
+    uint32_t m;
+    for (m = 0; m < 3u; ++m) transform->position[m] = coord(r, scale);
+    for (m = 0; m < 4u; ++m) {
+        q[m] = (float)(int8_t)next(r);
+        n2 += q[m] * q[m];
+    }
+    if (n2 == 0.0f) q[3] = n2 = 1.0f;
+    for (m = 0; m < 4u; ++m) transform->orientation[m] = q[m] / sqrtf(n2);
+    for (m = 0; m < 3u; ++m) scales[m] = scale_of(next(r));
+}
+
+/* What one trace of the scene checks against: its meshes' triangles (verts,
+ * split by ms; the instances' source holds the same), whether the scene has
+ * them as its own, and the sensor's place. */
+typedef struct trace_case {
+    const rc_scene *scene;
+    const rc_sensor *sensor;
+    const float *verts;
+    const mesh_split *ms;
+    int own_meshes;
+    float pos[3];
+    const float *origins; /* an OnDn sensor's offsets (zeros for one origin) */
+    uint32_t rays;
+} trace_case;
+
+/* Simulates the case's one pose and checks every ray: the hit it names is
+ * that of testing every triangle (library_is), its point lies at its range
+ * along the ray, its normal is a unit vector facing the sensor. */
+static void simulate_and_check(const trace_case *c)
+{
+    static float ranges[MAX_RAYS], points[MAX_RAYS * 3u], normals[MAX_RAYS * 3u];
+    static uint32_t prims[MAX_RAYS], geoms[MAX_RAYS], insts[MAX_RAYS];
     static uint8_t hits[MAX_RAYS];
-    reader r;
-    uint8_t flags;
-    int ondn, own_meshes;
-    enum layout layout;
-    float scale, pos[3];
-    uint32_t tris, rays, i, k, m, instances = 0;
-    mesh_split ms;
-    rc_rays_desc rd = rc_rays_desc_default();
     rc_results res = rc_results_default();
     rc_pose pose = rc_pose_identity();
-    rc_scene *scene = NULL, *source = NULL;
-    rc_sensor *sensor = NULL;
-    rc_status st;
-    if (ctx == NULL) setup();
-    r.p = data;
-    r.left = size;
-    flags = next(&r);
-    ondn = flags & 1u;
-    scale = ldexpf(1.0f, (int)((flags >> 1) & 15u) - 9); /* grid steps 1/512 .. 64 */
-    ctx->large_mesh_bytes = (flags & 32u) ? 0u : default_large_bytes;
-    layout = (enum layout)(flags >> 6);
-    tris = 1u + next(&r) % MAX_TRIS;
-    rays = 1u + next(&r) % MAX_RAYS;
-    for (k = 0; k < 3u; ++k) pos[k] = coord(&r, scale);
-    for (i = 0; i < rays; ++i) {
-        for (k = 0; k < 3u; ++k) dirs[3u * i + k] = (float)(int8_t)next(&r);
-        if (dirs[3u * i] == 0.0f && dirs[3u * i + 1] == 0.0f && dirs[3u * i + 2] == 0.0f) dirs[3u * i] = 1.0f;
-        for (k = 0; k < 3u; ++k) origins[3u * i + k] = ondn ? coord(&r, scale) : 0.0f;
-    }
-    for (i = 0; i < tris * 9u; ++i) verts[i] = coord(&r, scale);
-    for (i = 0; i < tris * 3u; ++i) indices[i] = i;
-
-    /* the meshes: tris split into nearly equal runs */
-    ms.count = layout == ONE_MESH ? 1u : 1u + next(&r) % MAX_MESHES;
-    if (ms.count > tris) ms.count = tris;
-    for (m = 0; m <= ms.count; ++m) ms.first[m] = (uint32_t)((uint64_t)tris * m / ms.count);
-    own_meshes = layout != INSTANCES_ONLY;
-
-    if (layout == MESHES_AND_INSTANCES || layout == INSTANCES_ONLY) {
-        instances = (layout == INSTANCES_ONLY ? 1u : 0u) + next(&r) % (MAX_INSTANCES + 1u);
-        if (instances > MAX_INSTANCES) instances = MAX_INSTANCES;
-        source = new_scene(tris, ms.count, 0u);
-        add_meshes(source, verts, indices, &ms);
-        FZ_REQUIRE(rc_scene_commit(source) == RC_OK, "the instances' source commits");
-    }
-    scene = new_scene(tris, own_meshes ? ms.count : 0u, instances);
-    if (own_meshes) add_meshes(scene, verts, indices, &ms);
-    for (k = 0; k < instances; ++k) {
-        rc_instance_desc id = rc_instance_desc_default();
-        float q[4], n2 = 0.0f;
-        uint32_t inst_id;
-        id.source = source;
-        for (m = 0; m < 3u; ++m) id.transform.position[m] = coord(&r, scale);
-        for (m = 0; m < 4u; ++m) {
-            q[m] = (float)(int8_t)next(&r);
-            n2 += q[m] * q[m];
-        }
-        if (n2 == 0.0f) q[3] = n2 = 1.0f;
-        for (m = 0; m < 4u; ++m) id.transform.orientation[m] = q[m] / sqrtf(n2);
-        for (m = 0; m < 3u; ++m) id.scale[m] = scale_of(next(&r));
-        st = rc_scene_add_instance(scene, &id, &inst_id);
-        FZ_REQUIRE(st == RC_OK, "an instance on the grid is accepted");
-        FZ_REQUIRE(inst_id == k, "instance ids count up");
-    }
-    FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "commit");
-
-    sensor = grid_sensor(&r, &rays);
-    if (sensor) { /* one origin: the OnDn offsets read above go unused */
-        ondn = 0;
-        memset(origins, 0, sizeof origins);
-    }
-    rd.common.range_min = 0.0f;
-    rd.common.range_max = RANGE_MAX;
-    rd.directions = dirs;
-    rd.origins = ondn ? origins : NULL;
-    rd.ray_count = rays;
-    if (sensor == NULL) {
-        st = rc_sensor_create_rays(ctx, ondn ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &rd, &sensor);
-        FZ_REQUIRE(st == RC_OK, "sensor");
-    }
-    memcpy(pose.position, pos, sizeof pos);
+    uint32_t i, k;
+    memcpy(pose.position, c->pos, sizeof c->pos);
     res.attributes = RC_ATTR_ALL;
     res.hits = hits;
     res.ranges = ranges;
@@ -380,28 +339,28 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     res.prim_ids = prims;
     res.geom_ids = geoms;
     res.inst_ids = insts;
-    res.capacity = rays;
-    FZ_REQUIRE(rc_simulate(ctx, scene, sensor, &pose, 1, &res) == RC_OK, "simulate");
-    for (i = 0; i < rays; ++i) {
+    res.capacity = c->rays;
+    FZ_REQUIRE(rc_simulate(ctx, c->scene, c->sensor, &pose, 1, &res) == RC_OK, "simulate");
+    for (i = 0; i < c->rays; ++i) {
         /* the rays as the library traces them: its unit directions, the
          * pose's translation (the turn is the identity) */
-        const float *d = sensor->directions + 3u * i, *o = origins + 3u * i, *p = points + 3u * i;
+        const float *d = c->sensor->directions + 3u * i, *o = c->origins + 3u * i, *p = points + 3u * i;
         const float *nv = normals + 3u * i;
         float org[3];
         double len2 = 0.0, facing = 0.0, off2 = 0.0;
         rc__hit h, hb;
-        for (k = 0; k < 3u; ++k) org[k] = pos[k] + o[k];
-        h = brute_nearest(scene, own_meshes, verts, &ms, org, d, 0);
+        for (k = 0; k < 3u; ++k) org[k] = c->pos[k] + o[k];
+        h = brute_nearest(c->scene, c->own_meshes, c->verts, c->ms, org, d, 0);
         /* or the nearest of the triangles whose own box the ray meets: a
          * triangle test can report a hit (by its rounding) on a triangle
          * whose box the slab test says the ray leaves at once, an origin on
          * a face of that box moving out of it (docs/architecture.md, "The
          * BVH"); the trees may skip such a triangle */
-        if (!library_is(scene, verts, &ms, org, d, &h, hits[i], geoms[i], prims[i], insts[i]))
-            hb = brute_nearest(scene, own_meshes, verts, &ms, org, d, 1);
+        if (!library_is(c->scene, c->verts, c->ms, org, d, &h, hits[i], geoms[i], prims[i], insts[i]))
+            hb = brute_nearest(c->scene, c->own_meshes, c->verts, c->ms, org, d, 1);
         else
             hb = h;
-        if (!library_is(scene, verts, &ms, org, d, &hb, hits[i], geoms[i], prims[i], insts[i])) {
+        if (!library_is(c->scene, c->verts, c->ms, org, d, &hb, hits[i], geoms[i], prims[i], insts[i])) {
             fprintf(stderr,
                     "ray %u: library hit %u prim %u geom %u inst %u range %.9g; every triangle: prim %u geom %u "
                     "inst %u t %.9g\n",
@@ -422,6 +381,143 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_REQUIRE(fabs(len2 - 1.0) <= 1e-5, "a hit's normal is a unit vector");
         FZ_REQUIRE(facing <= 1e-6, "a hit's normal faces the sensor");
     }
+}
+
+/* The dynamic-map step, from the input's bytes after the sensor's: each
+ * mesh may take new vertices (rewritten in place and the scenes told, so the
+ * next commits refit its trees: their boxes, and which triangles are folded
+ * flat for having zero area), each instance may move. A scene whose
+ * instances' source changed is refused until it commits again. Returns 1
+ * when anything changed (both scenes committed again), 0 when nothing did. */
+static int move_scene(reader *r, float scale, float *verts, const mesh_split *ms, rc_scene *scene,
+                      rc_scene *source, uint32_t instances, const trace_case *c)
+{
+    uint32_t m, i, k;
+    int moved = 0, source_moved = 0;
+    for (m = 0; m < ms->count; ++m) {
+        if (!(next(r) & 1u)) continue;
+        for (i = 9u * ms->first[m]; i < 9u * ms->first[m + 1]; ++i) verts[i] = coord(r, scale);
+        if (c->own_meshes) FZ_REQUIRE(rc_scene_update_mesh(scene, m) == RC_OK, "a moved mesh is taken");
+        if (source) FZ_REQUIRE(rc_scene_update_mesh(source, m) == RC_OK, "a moved source mesh is taken");
+        moved = 1;
+        source_moved |= source != NULL;
+    }
+    for (k = 0; k < instances; ++k) {
+        rc_pose transform = rc_pose_identity();
+        float scales[3];
+        if (!(next(r) & 1u)) continue;
+        placement(r, scale, &transform, scales);
+        FZ_REQUIRE(rc_scene_set_instance_transform(scene, k, &transform, scales) == RC_OK,
+                   "a move on the grid is accepted");
+        moved = 1;
+    }
+    if (!moved) return 0;
+    if (source_moved) {
+        static float ranges[MAX_RAYS];
+        rc_results res = rc_results_default();
+        rc_pose pose = rc_pose_identity();
+        FZ_REQUIRE(rc_scene_commit(source) == RC_OK, "the moved source commits");
+        for (i = 0; i < c->rays; ++i) ranges[i] = -7.0f;
+        res.attributes = RC_ATTR_RANGES;
+        res.ranges = ranges;
+        res.capacity = c->rays;
+        FZ_REQUIRE(rc_simulate(ctx, scene, c->sensor, &pose, 1, &res) == RC_ERR_NOT_COMMITTED,
+                   "a scene whose instances' source changed is refused until it commits");
+        for (i = 0; i < c->rays; ++i) FZ_REQUIRE(ranges[i] == -7.0f, "a refused call writes nothing");
+    }
+    FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "the moved scene commits");
+    return 1;
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    static float verts[MAX_TRIS * 9u], origins[MAX_RAYS * 3u], dirs[MAX_RAYS * 3u];
+    static uint32_t indices[MAX_TRIS * 3u];
+    reader r;
+    uint8_t flags, rays_byte;
+    int ondn, own_meshes, dynamic;
+    enum layout layout;
+    float scale, pos[3];
+    uint32_t tris, rays, i, k, m, instances = 0;
+    mesh_split ms;
+    rc_rays_desc rd = rc_rays_desc_default();
+    rc_scene *scene = NULL, *source = NULL;
+    rc_sensor *sensor = NULL;
+    trace_case tc;
+    rc_status st;
+    if (ctx == NULL) setup();
+    r.p = data;
+    r.left = size;
+    flags = next(&r);
+    ondn = flags & 1u;
+    scale = ldexpf(1.0f, (int)((flags >> 1) & 15u) - 9); /* grid steps 1/512 .. 64 */
+    ctx->large_mesh_bytes = (flags & 32u) ? 0u : default_large_bytes;
+    layout = (enum layout)(flags >> 6);
+    tris = 1u + next(&r) % MAX_TRIS;
+    /* the rays' byte: bits 0-5 the count, bit 6 a dynamic map (the meshes
+     * referenced, moved after the first trace) */
+    rays_byte = next(&r);
+    rays = 1u + rays_byte % MAX_RAYS;
+    dynamic = (rays_byte & 64u) != 0;
+    for (k = 0; k < 3u; ++k) pos[k] = coord(&r, scale);
+    for (i = 0; i < rays; ++i) {
+        for (k = 0; k < 3u; ++k) dirs[3u * i + k] = (float)(int8_t)next(&r);
+        if (dirs[3u * i] == 0.0f && dirs[3u * i + 1] == 0.0f && dirs[3u * i + 2] == 0.0f) dirs[3u * i] = 1.0f;
+        for (k = 0; k < 3u; ++k) origins[3u * i + k] = ondn ? coord(&r, scale) : 0.0f;
+    }
+    for (i = 0; i < tris * 9u; ++i) verts[i] = coord(&r, scale);
+    for (i = 0; i < tris * 3u; ++i) indices[i] = i;
+
+    /* the meshes: tris split into nearly equal runs */
+    ms.count = layout == ONE_MESH ? 1u : 1u + next(&r) % MAX_MESHES;
+    if (ms.count > tris) ms.count = tris;
+    for (m = 0; m <= ms.count; ++m) ms.first[m] = (uint32_t)((uint64_t)tris * m / ms.count);
+    own_meshes = layout != INSTANCES_ONLY;
+
+    if (layout == MESHES_AND_INSTANCES || layout == INSTANCES_ONLY) {
+        instances = (layout == INSTANCES_ONLY ? 1u : 0u) + next(&r) % (MAX_INSTANCES + 1u);
+        if (instances > MAX_INSTANCES) instances = MAX_INSTANCES;
+        source = new_scene(tris, ms.count, 0u);
+        add_meshes(source, verts, indices, &ms, dynamic);
+        FZ_REQUIRE(rc_scene_commit(source) == RC_OK, "the instances' source commits");
+    }
+    scene = new_scene(tris, own_meshes ? ms.count : 0u, instances);
+    if (own_meshes) add_meshes(scene, verts, indices, &ms, dynamic);
+    for (k = 0; k < instances; ++k) {
+        rc_instance_desc id = rc_instance_desc_default();
+        uint32_t inst_id;
+        id.source = source;
+        placement(&r, scale, &id.transform, id.scale);
+        st = rc_scene_add_instance(scene, &id, &inst_id);
+        FZ_REQUIRE(st == RC_OK, "an instance on the grid is accepted");
+        FZ_REQUIRE(inst_id == k, "instance ids count up");
+    }
+    FZ_REQUIRE(rc_scene_commit(scene) == RC_OK, "commit");
+
+    sensor = grid_sensor(&r, &rays);
+    if (sensor) { /* one origin: the OnDn offsets read above go unused */
+        ondn = 0;
+        memset(origins, 0, sizeof origins);
+    }
+    rd.common.range_min = 0.0f;
+    rd.common.range_max = RANGE_MAX;
+    rd.directions = dirs;
+    rd.origins = ondn ? origins : NULL;
+    rd.ray_count = rays;
+    if (sensor == NULL) {
+        st = rc_sensor_create_rays(ctx, ondn ? RC_SENSOR_ONDN : RC_SENSOR_O1DN, &rd, &sensor);
+        FZ_REQUIRE(st == RC_OK, "sensor");
+    }
+    tc.scene = scene;
+    tc.sensor = sensor;
+    tc.verts = verts;
+    tc.ms = &ms;
+    tc.own_meshes = own_meshes;
+    memcpy(tc.pos, pos, sizeof pos);
+    tc.origins = origins;
+    tc.rays = rays;
+    simulate_and_check(&tc);
+    if (dynamic && move_scene(&r, scale, verts, &ms, scene, source, instances, &tc)) simulate_and_check(&tc);
     FZ_REQUIRE(rc_sensor_destroy(sensor) == RC_OK, "sensor destroy");
     FZ_REQUIRE(rc_scene_destroy(scene) == RC_OK, "scene destroy");
     if (source) FZ_REQUIRE(rc_scene_destroy(source) == RC_OK, "source destroy");
