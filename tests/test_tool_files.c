@@ -267,6 +267,75 @@ static void test_cloud_files(void **state)
     rcu_cloud_free(&c);
 }
 
+/* 1 when path can be opened (C99 has no access()). */
+static int exists(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (f) fclose(f);
+    return f != NULL;
+}
+
+/* 1 when the two files hold the same bytes. */
+static int same_file(const char *a, const char *b)
+{
+    size_t na, nb;
+    unsigned char *da = slurp(a, &na), *db = slurp(b, &nb);
+    const int same = na == nb && memcmp(da, db, na) == 0;
+    free(da);
+    free(db);
+    return same;
+}
+
+/* A cloud written a batch at a time (rcu_cloud_stream): the two scans as two
+ * batches give the file rcu_cloud_write gives for both at once, in each
+ * format; the body beside it is gone after close, and an abort or a path
+ * that cannot be written leaves nothing. */
+static void test_cloud_stream(void **state)
+{
+    static const char *const names[4] = {"test_stream.pcd", "test_stream.ply", "test_stream.pcd", "test_stream.ply"};
+    rcu_cloud c;
+    rcu_cloud_stream st;
+    rcu_scan_view v, half;
+    int k;
+    (void)state;
+    scan_view(&v, NULL);
+    rcu_cloud_init(&c, RCU_CLOUD_RANGE | RCU_CLOUD_RING);
+    assert_int_equal(rcu_cloud_append(&c, &v), 0);
+    half = v;
+    half.pose_count = 1;
+    for (k = 0; k < 4; ++k) {
+        const int ascii = k >= 2;
+        assert_int_equal(rcu_cloud_write(k % 2 ? "test_whole.ply" : "test_whole.pcd", &c, ascii), 0);
+        assert_int_equal(rcu_cloud_stream_open(&st, names[k], c.fields, ascii), 0);
+        assert_int_equal(rcu_cloud_stream_append(&st, &half), 0); /* scan 0 */
+        half.points = v.points + 3u * v.rays_per_scan;
+        half.hits = v.hits + v.rays_per_scan;
+        assert_int_equal(rcu_cloud_stream_append(&st, &half), 0); /* scan 1 */
+        half.points = v.points;
+        half.hits = v.hits;
+        assert_int_equal(st.count, 6);
+        assert_int_equal(rcu_cloud_stream_close(&st), 0);
+        assert_true(same_file(names[k], k % 2 ? "test_whole.ply" : "test_whole.pcd"));
+        assert_false(exists(k % 2 ? "test_stream.ply.body.partial" : "test_stream.pcd.body.partial"));
+        remove(names[k]);
+    }
+    remove("test_whole.pcd");
+    remove("test_whole.ply");
+
+    assert_int_equal(rcu_cloud_stream_open(&st, "test_stream.ply", c.fields, 0), 0);
+    assert_int_equal(rcu_cloud_stream_append(&st, &v), 0);
+    rcu_cloud_stream_abort(&st);
+    assert_false(exists("test_stream.ply"));
+    assert_false(exists("test_stream.ply.body.partial"));
+    rcu_cloud_stream_abort(&st); /* a released stream: nothing to do */
+
+    assert_int_equal(rcu_cloud_stream_open(&st, "test_stream.xyz", c.fields, 0), -1);
+    expect_message("unknown point cloud format '.xyz'");
+    assert_int_equal(rcu_cloud_stream_open(&st, "no_such_dir/c.pcd", c.fields, 0), -1);
+    expect_message("no_such_dir/c.pcd");
+    rcu_cloud_free(&c);
+}
+
 /* An Ouster frame: the column window (wrapping or not) and destaggering as
  * the SDK does it, on a 3 x 5 field with known values. */
 static void test_ouster_frame(void **state)
@@ -316,6 +385,7 @@ int main(void)
         cmocka_unit_test(test_cloud_keeps_returns_and_fields),
         cmocka_unit_test(test_cloud_map_frame),
         cmocka_unit_test(test_cloud_files),
+        cmocka_unit_test(test_cloud_stream),
         cmocka_unit_test(test_ouster_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

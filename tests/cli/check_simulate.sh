@@ -99,6 +99,16 @@ grep -q "^format binary_little_endian 1.0" three.ply || fail "PLY format line"
 grep -q "^element vertex 43200" three.ply || fail "PLY vertex count"
 header=$(awk '{ n += length($0) + 1 } /^end_header/ { print n; exit }' three.ply)
 [ "$(wc -c <three.ply)" -eq $((header + 43200 * 16)) ] || fail "three.ply is not header + 43,200 x 16 bytes"
+# The same poses a call at a time, or two (--poses-per-call): the cloud goes
+# to the file a batch at a time, through a body file beside it that is gone
+# afterwards, and the files are the same byte for byte.
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three1.ply --fields range --poses-per-call 1 $BACKEND
+cmp three.ply three1.ply || fail "three.ply written a scan at a time differs"
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three2.pcd --ascii --fields range,ring $BACKEND
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three2b.pcd --ascii --fields range,ring \
+    --poses-per-call 2 $BACKEND
+cmp three2.pcd three2b.pcd || fail "three2.pcd written two scans at a time differs"
+ls ./*.partial >/dev/null 2>&1 && fail "a body file was left behind: $(ls ./*.partial)"
 
 # bench on the same files: --ranges-out holds float32 [pose][row][column]
 # (3 x 16 x 900), every range between the nearest and farthest the sphere can
@@ -196,6 +206,8 @@ fi
 run 2 "noise->dropout is 1.5" "$RC" simulate --map sphere.ply --pose 0,0,0 -o i.pcd --dropout 1.5
 run 2 "noise->sigma is -1" "$RC" simulate --map sphere.ply --pose 0,0,0 -o j.pcd --noise -1
 run 2 "--seed: expected a decimal" "$RC" simulate --map sphere.ply --pose 0,0,0 -o k.pcd --seed -1
+run 2 "--poses-per-call: expected a count >= 1, got '0'" "$RC" simulate --map sphere.ply --pose 0,0,0 -o p.pcd \
+    --poses-per-call 0
 # A write that fails (a full disk): exit 1 with the message; a device at the
 # path is left alone.
 if [ -c /dev/full ]; then
@@ -213,9 +225,11 @@ run 1 "o.p" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o o.ply --imag
 [ ! -e o.png ] && [ ! -e o.ppm ] || fail "a half-written range image was left behind"
 run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --ranges-out n.bin \
     $BACKEND
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply p.pcd; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
+    [ ! -e "$f.body.partial" ] || fail "a failed run left $f.body.partial"
 done
+[ ! -e full.pcd.body.partial ] || fail "a failed run left full.pcd.body.partial"
 # An Ouster unit from its metadata (--sensor ouster:FILE, rc_ouster_rays): 16
 # beams x 512 measurement ids from the sphere's centre. Every point lies on the
 # sphere (|point| is measured from the sensor origin) and its range, measured

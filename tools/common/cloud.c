@@ -183,40 +183,49 @@ static int finish(FILE *f, const char *path, int st)
     return rcu_fail("%s: write error", path);
 }
 
+static void write_ply_header(FILE *f, uint32_t fields, size_t count, int ascii)
+{
+    int k;
+    fprintf(f, "ply\nformat %s 1.0\ncomment written by rangecast\nelement vertex %zu\n"
+               "property float x\nproperty float y\nproperty float z\n",
+            ascii ? "ascii" : "binary_little_endian", count);
+    for (k = 0; k < N_EXTRA; k++)
+        if (fields & extra_fields[k].flag) fprintf(f, "property %s %s\n", extra_fields[k].ply_type, extra_fields[k].name);
+    fprintf(f, "end_header\n");
+}
+
+static void write_pcd_header(FILE *f, uint32_t fields, size_t count, int ascii)
+{
+    int k;
+    fprintf(f, "# .PCD v0.7 - Point Cloud Data file format (written by rangecast)\nVERSION 0.7\nFIELDS x y z");
+    for (k = 0; k < N_EXTRA; k++)
+        if (fields & extra_fields[k].flag) fprintf(f, " %s", extra_fields[k].name);
+    fprintf(f, "\nSIZE 4 4 4");
+    for (k = 0; k < N_EXTRA; k++)
+        if (fields & extra_fields[k].flag) fprintf(f, " %d", extra_fields[k].size);
+    fprintf(f, "\nTYPE F F F");
+    for (k = 0; k < N_EXTRA; k++)
+        if (fields & extra_fields[k].flag) fprintf(f, " %c", extra_fields[k].pcd_type);
+    fprintf(f, "\nCOUNT 1 1 1");
+    for (k = 0; k < N_EXTRA; k++)
+        if (fields & extra_fields[k].flag) fprintf(f, " 1");
+    fprintf(f, "\nWIDTH %zu\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %zu\nDATA %s\n", count, count,
+            ascii ? "ascii" : "binary");
+}
+
 int rcu_cloud_write_ply(const char *path, const rcu_cloud *c, int ascii)
 {
     FILE *f = fopen(path, "wb");
-    int k;
     if (!f) return rcu_fail("%s: %s", path, strerror(errno));
-    fprintf(f, "ply\nformat %s 1.0\ncomment written by rangecast\nelement vertex %zu\n"
-               "property float x\nproperty float y\nproperty float z\n",
-            ascii ? "ascii" : "binary_little_endian", c->count);
-    for (k = 0; k < N_EXTRA; k++)
-        if (c->fields & extra_fields[k].flag)
-            fprintf(f, "property %s %s\n", extra_fields[k].ply_type, extra_fields[k].name);
-    fprintf(f, "end_header\n");
+    write_ply_header(f, c->fields, c->count, ascii);
     return finish(f, path, write_body(f, c, ascii));
 }
 
 int rcu_cloud_write_pcd(const char *path, const rcu_cloud *c, int ascii)
 {
     FILE *f = fopen(path, "wb");
-    int k;
     if (!f) return rcu_fail("%s: %s", path, strerror(errno));
-    fprintf(f, "# .PCD v0.7 - Point Cloud Data file format (written by rangecast)\nVERSION 0.7\nFIELDS x y z");
-    for (k = 0; k < N_EXTRA; k++)
-        if (c->fields & extra_fields[k].flag) fprintf(f, " %s", extra_fields[k].name);
-    fprintf(f, "\nSIZE 4 4 4");
-    for (k = 0; k < N_EXTRA; k++)
-        if (c->fields & extra_fields[k].flag) fprintf(f, " %d", extra_fields[k].size);
-    fprintf(f, "\nTYPE F F F");
-    for (k = 0; k < N_EXTRA; k++)
-        if (c->fields & extra_fields[k].flag) fprintf(f, " %c", extra_fields[k].pcd_type);
-    fprintf(f, "\nCOUNT 1 1 1");
-    for (k = 0; k < N_EXTRA; k++)
-        if (c->fields & extra_fields[k].flag) fprintf(f, " 1");
-    fprintf(f, "\nWIDTH %zu\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS %zu\nDATA %s\n", c->count,
-            c->count, ascii ? "ascii" : "binary");
+    write_pcd_header(f, c->fields, c->count, ascii);
     return finish(f, path, write_body(f, c, ascii));
 }
 
@@ -227,4 +236,95 @@ int rcu_cloud_write(const char *path, const rcu_cloud *cloud, int ascii)
     if (strcmp(ext, "ply") == 0) return rcu_cloud_write_ply(path, cloud, ascii);
     if (strcmp(ext, "pcd") == 0) return rcu_cloud_write_pcd(path, cloud, ascii);
     return rcu_fail("%s: unknown point cloud format '.%s' (use .ply or .pcd)", path, ext);
+}
+
+/* Streaming (cloud.h). */
+
+static void stream_release(rcu_cloud_stream *s, int keep);
+
+int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields, int ascii)
+{
+    char ext[8];
+    size_t len = strlen(path);
+    memset(s, 0, sizeof *s);
+    rcu_path_extension(path, ext, sizeof ext);
+    if (strcmp(ext, "ply") != 0 && strcmp(ext, "pcd") != 0)
+        return rcu_fail("%s: unknown point cloud format '.%s' (use .ply or .pcd)", path, ext);
+    s->pcd = strcmp(ext, "pcd") == 0;
+    s->ascii = ascii;
+    rcu_cloud_init(&s->batch, fields);
+    s->path = (char *)malloc(len + 1u);
+    s->body_path = (char *)malloc(len + sizeof ".body.partial");
+    if (!s->path || !s->body_path) {
+        rcu_cloud_stream_abort(s);
+        return rcu_fail("out of memory");
+    }
+    memcpy(s->path, path, len + 1u);
+    memcpy(s->body_path, path, len);
+    memcpy(s->body_path + len, ".body.partial", sizeof ".body.partial");
+    /* the output is opened now, so that a path it cannot take fails
+     * before the work, not after it */
+    if (!(s->out = fopen(path, "wb"))) {
+        const int e = errno;
+        stream_release(s, 1); /* not ours to remove: a file there stays */
+        return rcu_fail("%s: %s", path, strerror(e));
+    }
+    if (!(s->body = fopen(s->body_path, "w+b"))) {
+        const int e = errno;
+        rcu_fail("%s: %s", s->body_path, strerror(e));
+        rcu_cloud_stream_abort(s);
+        return -1;
+    }
+    return 0;
+}
+
+int rcu_cloud_stream_append(rcu_cloud_stream *s, const rcu_scan_view *view)
+{
+    s->batch.count = 0;
+    if (rcu_cloud_append(&s->batch, view) != 0) return -1;
+    if (write_body(s->body, &s->batch, s->ascii) != 0) return rcu_fail("%s: write error", s->path);
+    s->count += s->batch.count;
+    return 0;
+}
+
+/* Frees what s holds and closes its files (the body is removed; the output
+ * removed too unless keep). */
+static void stream_release(rcu_cloud_stream *s, int keep)
+{
+    if (s->body) fclose(s->body);
+    if (s->body_path) remove(s->body_path);
+    if (s->out) fclose(s->out);
+    if (s->path && !keep) rcu_remove_partial(s->path);
+    free(s->path);
+    free(s->body_path);
+    rcu_cloud_free(&s->batch);
+    memset(s, 0, sizeof *s);
+}
+
+void rcu_cloud_stream_abort(rcu_cloud_stream *s) { stream_release(s, 0); }
+
+int rcu_cloud_stream_close(rcu_cloud_stream *s)
+{
+    enum { COPY = 1 << 20 };
+    unsigned char *buf = (unsigned char *)malloc(COPY);
+    int st = buf ? 0 : -1;
+    size_t n;
+    if (s->pcd)
+        write_pcd_header(s->out, s->batch.fields, s->count, s->ascii);
+    else
+        write_ply_header(s->out, s->batch.fields, s->count, s->ascii);
+    if (st == 0 && (fflush(s->body) != 0 || fseek(s->body, 0L, SEEK_SET) != 0)) st = -1;
+    while (st == 0 && (n = fread(buf, 1, COPY, s->body)) > 0)
+        if (fwrite(buf, 1, n, s->out) != n) st = -1;
+    if (ferror(s->body) || ferror(s->out)) st = -1;
+    free(buf);
+    if (fclose(s->out) != 0) st = -1;
+    s->out = NULL;
+    if (st != 0) {
+        rcu_fail("%s: write error", s->path);
+        stream_release(s, 0);
+        return -1;
+    }
+    stream_release(s, 1);
+    return 0;
 }

@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "rangecast/rangecast.h"
 #include "util.h"
@@ -51,5 +52,30 @@ int rcu_cloud_write_ply(const char *path, const rcu_cloud *cloud, int ascii);
 int rcu_cloud_write_pcd(const char *path, const rcu_cloud *cloud, int ascii);
 /* By the extension: .ply or .pcd (else an error). */
 int rcu_cloud_write(const char *path, const rcu_cloud *cloud, int ascii);
+
+/* A cloud written batch by batch, for more scans than memory holds (a long
+ * trajectory): each batch's records go to a body file beside the output
+ * (PATH.body.partial) as they come, and close writes the header, whose
+ * count is known only then, and the body after it, in the same format as
+ * rcu_cloud_write (.ply or .pcd by the extension). Only one batch is in
+ * memory at a time. Every function returns 0, or -1 with rcu_last_error();
+ * after a failure of append call abort. Nothing is left at PATH unless
+ * close succeeds. */
+typedef struct rcu_cloud_stream {
+    char *path, *body_path;
+    FILE *out, *body;
+    int pcd, ascii;
+    rcu_cloud batch; /* its fields are the file's; it holds the batch in hand */
+    size_t count;    /* records in the body */
+} rcu_cloud_stream;
+
+/* Opens PATH (so a path that cannot be written fails before the work) and the body. */
+int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields, int ascii);
+/* Appends the valid returns of every scan in the view (as rcu_cloud_append). */
+int rcu_cloud_stream_append(rcu_cloud_stream *s, const rcu_scan_view *view);
+/* Writes PATH whole and removes the body; s is released either way. */
+int rcu_cloud_stream_close(rcu_cloud_stream *s);
+/* Removes the body and PATH; s is released. Safe on a released stream. */
+void rcu_cloud_stream_abort(rcu_cloud_stream *s);
 
 #endif

@@ -1,10 +1,12 @@
 /* rangecast simulate: a sensor at one or many poses in a mesh map -> a point
- * cloud of every return (and a range image of the first scan). */
+ * cloud of every return, written a batch of scans at a time (and a range
+ * image of the first scan). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cloud.h"
 #include "mesh_load.h"
@@ -39,6 +41,9 @@ static void usage(FILE *f)
         "                      by its pixel_shift_by_row (as Ouster's SDK shows a frame)\n"
         "  --backend B         auto (default), bvh, embree, vulkan\n"
         "  --threads N         worker threads, 0 = all CPUs (default)\n"
+        "  --poses-per-call N  poses an rc_simulate call takes, each call's returns then\n"
+        "                      written to OUT (default: as many as 128 MiB of results hold,\n"
+        "                      321 VLP-16 scans), so a trajectory need not fit in memory\n"
         "  -o, --output OUT    .ply or .pcd (binary unless --ascii)\n"
         "  --ascii             write ascii PLY/PCD\n"
         "  --frame F           sensor (default: each scan in its own sensor frame) or map\n"
@@ -61,6 +66,7 @@ typedef struct sim_args {
     int have_pose, ascii, map_frame;
     rc_pose pose;
     uint32_t preset, backend, threads, fields, image_mode;
+    uint32_t poses_per_call; /* 0: by SIM_CHUNK_BYTES */
     rc_noise_desc noise; /* all zero: none */
 } sim_args;
 
@@ -153,6 +159,10 @@ static int parse_args(int argc, char **argv, sim_args *a)
             a->sensor_name = v;
         } else if (OPT("--backend")) {
             if (r < 0 || rcp_parse_backend(cmd, v, &a->backend) != 0) return -1;
+        } else if (OPT("--poses-per-call")) {
+            if (r < 0) return -1;
+            if (rcp_parse_u32(v, &a->poses_per_call) != 0 || a->poses_per_call == 0)
+                return rcp_usage_error(cmd, "--poses-per-call: expected a count >= 1, got '%s'", v), -1;
         } else if (OPT("--threads")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &a->threads) != 0 || a->threads > RC_MAX_THREADS)
@@ -242,12 +252,14 @@ int rcp_cmd_simulate(int argc, char **argv)
     uint32_t pose_count = 0, rays, chunk, p;
     rcp_world w;
     rc_sensor_info si = rc_sensor_info_default();
-    rcu_cloud cloud;
+    rcu_cloud_stream out;
+    int out_open = 0;
     rcu_preset_rays ref;
     rcp_rays ou;
     float *points = NULL, *ranges = NULL, *normals = NULL, *image = NULL;
     uint8_t *hits = NULL;
     double t_sim = 0.0;
+    size_t returns = 0;
     int rc = RCP_EXIT_FAIL;
     char n1[32], n2[32];
 
@@ -255,7 +267,6 @@ int rcp_cmd_simulate(int argc, char **argv)
     memset(&w, 0, sizeof w);
     memset(&ref, 0, sizeof ref);
     memset(&ou, 0, sizeof ou);
-    rcu_cloud_init(&cloud, a.fields);
     if (rcp_mesh_load(a.map, &mesh) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
     if (a.poses_path) {
         if (rcu_poses_read(a.poses_path, &poses, &pose_count) != 0) {
@@ -299,7 +310,14 @@ int rcp_cmd_simulate(int argc, char **argv)
 
     chunk = (uint32_t)(SIM_CHUNK_BYTES / ((size_t)rays * 29u));
     if (chunk == 0) chunk = 1;
+    if (a.poses_per_call) chunk = a.poses_per_call;
     if (chunk > pose_count) chunk = pose_count;
+    /* results a call: 29 bytes a ray at most (points, normals, range, hit) */
+    if ((uint64_t)chunk * rays * 29u > (uint64_t)(SIZE_MAX / 2u)) {
+        rcp_fail(cmd, "--poses-per-call %u: the results of %u scans do not fit in this machine's memory", chunk,
+                 chunk);
+        goto done;
+    }
     points = (float *)malloc((size_t)chunk * rays * 3u * sizeof(float));
     ranges = (float *)malloc((size_t)chunk * rays * sizeof(float));
     hits = (uint8_t *)malloc((size_t)chunk * rays);
@@ -308,6 +326,13 @@ int rcp_cmd_simulate(int argc, char **argv)
         rcp_fail(cmd, "out of memory for %u scans of results", chunk);
         goto done;
     }
+    /* the cloud goes to the file a batch at a time: a long trajectory's
+     * scans need not fit in memory */
+    if (rcu_cloud_stream_open(&out, a.out, a.fields, a.ascii) != 0) {
+        rcp_fail(cmd, "%s", rcu_last_error());
+        goto done;
+    }
+    out_open = 1;
     for (p = 0; p < pose_count; p += chunk) {
         uint32_t n = pose_count - p < chunk ? pose_count - p : chunk;
         rc_results res = rc_results_default();
@@ -342,10 +367,14 @@ int rcp_cmd_simulate(int argc, char **argv)
         view.pose_count = n;
         view.poses = a.map_frame ? poses + p : NULL;
         view.sensor_to_base = &ref.mount;
-        if (rcu_cloud_append(&cloud, &view) != 0) {
+        if (rcu_cloud_stream_append(&out, &view) != 0) {
             rcp_fail(cmd, "%s", rcu_last_error());
             goto done;
         }
+        /* several batches on a terminal: how far it got, rewritten in place */
+        if (pose_count > chunk && isatty(STDERR_FILENO))
+            fprintf(stderr, "\rrangecast simulate: %s of %s scans%s", rcp_thousands(p + n, n1, sizeof n1),
+                    rcp_thousands(pose_count, n2, sizeof n2), p + n == pose_count ? "\n" : "");
         if (p == 0 && a.image) {
             const float *shown = ranges;
             if (a.ouster_path && ou.pixel_shift) { /* destaggered, as the SDK shows a frame */
@@ -360,7 +389,9 @@ int rcp_cmd_simulate(int argc, char **argv)
             if (write_image(cmd, a.image, a.preset, &si, shown, a.image_mode) != 0) goto done;
         }
     }
-    if (rcu_cloud_write(a.out, &cloud, a.ascii) != 0) {
+    returns = out.count;
+    out_open = 0;
+    if (rcu_cloud_stream_close(&out) != 0) {
         rcp_fail(cmd, "%s", rcu_last_error());
         goto done;
     }
@@ -369,8 +400,8 @@ int rcp_cmd_simulate(int argc, char **argv)
                         "(--frame map places them in the map)\n", pose_count);
     printf("%s: %u scan%s x %s rays, %s returns (%.1f%%), simulated in %.3f s (%.0f scans/s, %s, %u threads) -> %s",
            a.sensor_name, pose_count, pose_count == 1 ? "" : "s", rcp_thousands(rays, n1, sizeof n1),
-           rcp_thousands(cloud.count, n2, sizeof n2),
-           100.0 * (double)cloud.count / ((double)pose_count * rays), t_sim,
+           rcp_thousands(returns, n2, sizeof n2),
+           100.0 * (double)returns / ((double)pose_count * rays), t_sim,
            t_sim > 0 ? pose_count / t_sim : 0.0, rc_backend_name(w.backend), w.threads, a.out);
     if (a.image) printf(", %s", a.image);
     printf("\n");
@@ -379,7 +410,7 @@ done:
     rcp_world_destroy(&w);
     rcu_preset_rays_free(&ref);
     rcp_rays_free(&ou);
-    rcu_cloud_free(&cloud);
+    if (out_open) rcu_cloud_stream_abort(&out);
     free(points);
     free(ranges);
     free(image);
