@@ -306,6 +306,12 @@ static void test_cloud_stream(void **state)
     for (k = 0; k < 4; ++k) {
         const int ascii = k >= 2;
         assert_int_equal(rcu_cloud_write(k % 2 ? "test_whole.ply" : "test_whole.pcd", &c, ascii), 0);
+        /* both scans as one batch, written at close with no body */
+        assert_int_equal(rcu_cloud_stream_open(&st, names[k], c.fields, ascii), 0);
+        assert_int_equal(rcu_cloud_stream_append(&st, &v), 0);
+        assert_int_equal(rcu_cloud_stream_close(&st), 0);
+        assert_true(same_file(names[k], k % 2 ? "test_whole.ply" : "test_whole.pcd"));
+        /* a batch a scan: the first through the body */
         assert_int_equal(rcu_cloud_stream_open(&st, names[k], c.fields, ascii), 0);
         assert_int_equal(rcu_cloud_stream_append(&st, &half), 0); /* scan 0 */
         half.points = v.points + 3u * v.rays_per_scan;
@@ -322,8 +328,13 @@ static void test_cloud_stream(void **state)
     remove("test_whole.pcd");
     remove("test_whole.ply");
 
+    /* a single batch goes straight to the output at close; a second sends
+     * the first to the body; an abort then removes both */
     assert_int_equal(rcu_cloud_stream_open(&st, "test_stream.ply", c.fields, 0), 0);
     assert_int_equal(rcu_cloud_stream_append(&st, &v), 0);
+    assert_false(exists("test_stream.ply.body.partial"));
+    assert_int_equal(rcu_cloud_stream_append(&st, &v), 0);
+    assert_true(exists("test_stream.ply.body.partial"));
     rcu_cloud_stream_abort(&st);
     assert_false(exists("test_stream.ply"));
     assert_false(exists("test_stream.ply.body.partial"));

@@ -238,9 +238,23 @@ int rcu_cloud_write(const char *path, const rcu_cloud *cloud, int ascii)
     return rcu_fail("%s: unknown point cloud format '.%s' (use .ply or .pcd)", path, ext);
 }
 
-/* Streaming (cloud.h). */
+/* Streaming (cloud.h). The latest batch is held in memory, the ones before
+ * it went to the body: a stream of one batch (a cloud that fits one call)
+ * is written straight to the output at close, with no body and no copy. */
 
-static void stream_release(rcu_cloud_stream *s, int keep);
+/* Frees what s holds and closes its files (the body is removed; the output
+ * removed too unless keep). */
+static void stream_release(rcu_cloud_stream *s, int keep)
+{
+    if (s->body) fclose(s->body);
+    if (s->body && s->body_path) remove(s->body_path);
+    if (s->out) fclose(s->out);
+    if (s->path && !keep) rcu_remove_partial(s->path);
+    free(s->path);
+    free(s->body_path);
+    rcu_cloud_free(&s->batch);
+    memset(s, 0, sizeof *s);
+}
 
 int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields, int ascii)
 {
@@ -256,7 +270,7 @@ int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields
     s->path = (char *)malloc(len + 1u);
     s->body_path = (char *)malloc(len + sizeof ".body.partial");
     if (!s->path || !s->body_path) {
-        rcu_cloud_stream_abort(s);
+        stream_release(s, 1);
         return rcu_fail("out of memory");
     }
     memcpy(s->path, path, len + 1u);
@@ -269,55 +283,52 @@ int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields
         stream_release(s, 1); /* not ours to remove: a file there stays */
         return rcu_fail("%s: %s", path, strerror(e));
     }
-    if (!(s->body = fopen(s->body_path, "w+b"))) {
-        const int e = errno;
-        rcu_fail("%s: %s", s->body_path, strerror(e));
-        rcu_cloud_stream_abort(s);
-        return -1;
-    }
+    return 0;
+}
+
+/* The held batch to the body (opened at the first). */
+static int stream_flush(rcu_cloud_stream *s)
+{
+    if (s->batch.count == 0) return 0;
+    if (!s->body && !(s->body = fopen(s->body_path, "w+b"))) return rcu_fail("%s: %s", s->body_path, strerror(errno));
+    if (write_body(s->body, &s->batch, s->ascii) != 0) return rcu_fail("%s: write error", s->path);
+    s->batch.count = 0;
     return 0;
 }
 
 int rcu_cloud_stream_append(rcu_cloud_stream *s, const rcu_scan_view *view)
 {
-    s->batch.count = 0;
-    if (rcu_cloud_append(&s->batch, view) != 0) return -1;
-    if (write_body(s->body, &s->batch, s->ascii) != 0) return rcu_fail("%s: write error", s->path);
+    if (stream_flush(s) != 0) return -1;
+    if (rcu_cloud_append(&s->batch, view) != 0) {
+        s->batch.count = 0;
+        return -1;
+    }
     s->count += s->batch.count;
     return 0;
-}
-
-/* Frees what s holds and closes its files (the body is removed; the output
- * removed too unless keep). */
-static void stream_release(rcu_cloud_stream *s, int keep)
-{
-    if (s->body) fclose(s->body);
-    if (s->body_path) remove(s->body_path);
-    if (s->out) fclose(s->out);
-    if (s->path && !keep) rcu_remove_partial(s->path);
-    free(s->path);
-    free(s->body_path);
-    rcu_cloud_free(&s->batch);
-    memset(s, 0, sizeof *s);
 }
 
 void rcu_cloud_stream_abort(rcu_cloud_stream *s) { stream_release(s, 0); }
 
 int rcu_cloud_stream_close(rcu_cloud_stream *s)
 {
-    enum { COPY = 1 << 20 };
-    unsigned char *buf = (unsigned char *)malloc(COPY);
-    int st = buf ? 0 : -1;
-    size_t n;
+    int st = 0;
     if (s->pcd)
         write_pcd_header(s->out, s->batch.fields, s->count, s->ascii);
     else
         write_ply_header(s->out, s->batch.fields, s->count, s->ascii);
-    if (st == 0 && (fflush(s->body) != 0 || fseek(s->body, 0L, SEEK_SET) != 0)) st = -1;
-    while (st == 0 && (n = fread(buf, 1, COPY, s->body)) > 0)
-        if (fwrite(buf, 1, n, s->out) != n) st = -1;
-    if (ferror(s->body) || ferror(s->out)) st = -1;
-    free(buf);
+    if (s->body) {
+        enum { COPY = 1 << 20 };
+        unsigned char *buf = (unsigned char *)malloc(COPY);
+        size_t n;
+        st = buf && stream_flush(s) == 0 && fflush(s->body) == 0 && fseek(s->body, 0L, SEEK_SET) == 0 ? 0 : -1;
+        while (st == 0 && (n = fread(buf, 1, COPY, s->body)) > 0)
+            if (fwrite(buf, 1, n, s->out) != n) st = -1;
+        if (ferror(s->body)) st = -1;
+        free(buf);
+    } else {
+        st = write_body(s->out, &s->batch, s->ascii);
+    }
+    if (ferror(s->out)) st = -1;
     if (fclose(s->out) != 0) st = -1;
     s->out = NULL;
     if (st != 0) {

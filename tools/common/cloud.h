@@ -54,9 +54,10 @@ int rcu_cloud_write_pcd(const char *path, const rcu_cloud *cloud, int ascii);
 int rcu_cloud_write(const char *path, const rcu_cloud *cloud, int ascii);
 
 /* A cloud written batch by batch, for more scans than memory holds (a long
- * trajectory): each batch's records go to a body file beside the output
- * (PATH.body.partial) as they come, and close writes the header, whose
- * count is known only then, and the body after it, in the same format as
+ * trajectory): a batch is held until the next comes, then its records go
+ * to a body file beside the output (PATH.body.partial); close writes the
+ * header, whose count is known only then, and the records after it (copied
+ * from the body, or the one batch straight), in the same format as
  * rcu_cloud_write (.ply or .pcd by the extension). Only one batch is in
  * memory at a time. Every function returns 0, or -1 with rcu_last_error();
  * after a failure of append call abort. Nothing is left at PATH unless
@@ -69,7 +70,7 @@ typedef struct rcu_cloud_stream {
     size_t count;    /* records in the body */
 } rcu_cloud_stream;
 
-/* Opens PATH (so a path that cannot be written fails before the work) and the body. */
+/* Opens PATH, so that a path that cannot be written fails before the work. */
 int rcu_cloud_stream_open(rcu_cloud_stream *s, const char *path, uint32_t fields, int ascii);
 /* Appends the valid returns of every scan in the view (as rcu_cloud_append). */
 int rcu_cloud_stream_append(rcu_cloud_stream *s, const rcu_scan_view *view);
