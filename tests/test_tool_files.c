@@ -112,6 +112,76 @@ static void test_pose_file_errors(void **state)
     expect_message("no_such_dir/p.bin");
 }
 
+/* A text file of the given contents. */
+static void write_text(const char *path, const char *text) { write_bytes(path, (const unsigned char *)text, strlen(text)); }
+
+/* TUM trajectories (.tum/.txt, tum.h): written and read back bit for bit;
+ * comments, blank lines, CRLF, tabs and commas read; each bad line named by
+ * its number, and nothing handed back. */
+static void test_pose_file_tum(void **state)
+{
+    const char *path = "test_tool_files.tum";
+    rc_pose p[5], *out = NULL;
+    uint32_t count = 0, k;
+    (void)state;
+    rcu_poses_random(5, 10.0f, 3, p);
+    assert_int_equal(rcu_poses_write(path, p, 5), 0);
+    assert_int_equal(rcu_poses_read(path, &out, &count), 0);
+    assert_int_equal(count, 5);
+    assert_memory_equal(out, p, sizeof p);
+    free(out);
+
+    write_text("test_tool_files.txt", "# time x y z qx qy qz qw\r\n\r\n"
+                                      "1.5 1 -2 3.25 0 0 0 1\r\n"
+                                      "  \t# a comment\n"
+                                      "1.6,0.5,0,0,0,0,0.70710678,0.70710678\n"
+                                      "1.7\t4 5 6 1 0 0 0");
+    assert_int_equal(rcu_poses_read("test_tool_files.txt", &out, &count), 0);
+    assert_int_equal(count, 3);
+    assert_true(out[0].position[0] == 1.0f && out[0].position[1] == -2.0f && out[0].position[2] == 3.25f);
+    assert_true(out[0].orientation[3] == 1.0f);
+    assert_true(out[1].position[0] == 0.5f && out[1].orientation[2] == 0.70710678f);
+    assert_true(out[2].position[2] == 6.0f && out[2].orientation[0] == 1.0f);
+    free(out);
+    remove("test_tool_files.txt");
+
+    out = (rc_pose *)0x1;
+    count = 77;
+    write_text(path, "# header\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message("test_tool_files.tum:3: 7 numbers (expected 8");
+    write_text(path, "1 0 0 0 0 0 0 1 9\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message(":1: more than 8 numbers");
+    write_text(path, "1 0 0 x 0 0 0 1\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message(":1: not a number");
+    write_text(path, "\n1 0 nan 0 0 0 0 1\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message(":2: value 3 is not finite");
+    write_text(path, "1 0 1e39 0 0 0 0 1\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message(":1: value 3 is not finite in float");
+    write_text(path, "1 0 0 0 0 0 0 2\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message(":1: quaternion (0, 0, 0, 2) has norm 2");
+    write_text(path, "# only a comment\n\n");
+    assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+    expect_message("no pose");
+    for (k = 0; k < 2; ++k) {
+        /* a raw pose file misnamed .tum: its bytes are no text */
+        unsigned char raw[28] = {0};
+        write_bytes(path, raw, k ? sizeof raw : 0);
+        assert_int_equal(rcu_poses_read(path, &out, &count), -1);
+        expect_message(k ? "NUL byte" : "no pose");
+    }
+    assert_true(out == (rc_pose *)0x1);
+    assert_int_equal(count, 77);
+    remove(path);
+    assert_int_equal(rcu_poses_write("no_such_dir/p.tum", p, 3), -1);
+    expect_message("no_such_dir/p.tum");
+}
+
 /* The benchmark's poses (`rangecast gen --poses`, bench without --poses) are
  * part of its definition: the first three of seed 1, as x86-64 computed them
  * when the workload was fixed. Positions come from integer arithmetic and
@@ -392,6 +462,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_pose_file_round_trip),
         cmocka_unit_test(test_pose_file_errors),
+        cmocka_unit_test(test_pose_file_tum),
         cmocka_unit_test(test_standard_poses_pinned),
         cmocka_unit_test(test_cloud_keeps_returns_and_fields),
         cmocka_unit_test(test_cloud_map_frame),

@@ -109,6 +109,14 @@ run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three2b.pcd --asci
     --poses-per-call 2 $BACKEND
 cmp three2.pcd three2b.pcd || fail "three2.pcd written two scans at a time differs"
 ls ./*.partial >/dev/null 2>&1 && fail "a body file was left behind: $(ls ./*.partial)"
+# The same poses as a TUM trajectory (gen writes one for .tum; lines
+# 'timestamp x y z qx qy qz qw'): the same cloud. A bad line is named.
+run 0 "" "$RC" gen --poses 3 --radius 10 --seed 7 -o poses.tum
+[ "$(grep -vc '^#' poses.tum)" -eq 3 ] || fail "poses.tum does not hold 3 poses"
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.tum -o three_tum.ply --fields range $BACKEND
+cmp three.ply three_tum.ply || fail "the TUM trajectory's cloud differs from the raw poses'"
+printf '0.0 1 2 3 0 0 0 1\n0.1 1 2 3 0 0 1\n' >short.tum
+run 1 "short.tum:2: 7 numbers" "$RC" simulate --map sphere.ply --poses short.tum -o q.pcd
 
 # bench on the same files: --ranges-out holds float32 [pose][row][column]
 # (3 x 16 x 900), every range between the nearest and farthest the sphere can
@@ -225,7 +233,7 @@ run 1 "o.p" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o o.ply --imag
 [ ! -e o.png ] && [ ! -e o.ppm ] || fail "a half-written range image was left behind"
 run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --ranges-out n.bin \
     $BACKEND
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply p.pcd; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply p.pcd q.pcd; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
     [ ! -e "$f.body.partial" ] || fail "a failed run left $f.body.partial"
 done

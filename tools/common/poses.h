@@ -1,4 +1,5 @@
-/* rcutil: raw pose files and the standard random poses.
+/* rcutil: pose files (raw, or TUM trajectories: tum.h) and the standard
+ * random poses.
  *
  * A raw pose file is a sequence of little-endian float32, 7 per pose:
  * x y z qx qy qz qw (base-to-map), 28 bytes a pose, no header. It maps onto an
@@ -15,10 +16,13 @@
 
 /* Reads a pose file into a malloc'd array (free() it). Fails (-1, message in
  * rcu_last_error) on an empty file, a size that is not a multiple of 28 bytes,
- * or a non-finite value or a quaternion far from unit length (naming the pose). */
+ * or a non-finite value or a quaternion far from unit length (naming the pose).
+ * A path ending in .tum or .txt is read as a TUM trajectory (tum.h). */
 int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count);
 
-/* Writes count poses. */
+/* Writes count poses; to a .tum or .txt path as a TUM trajectory, poses
+ * RCU_TUM_PERIOD seconds apart (a spinning LiDAR's 10 Hz). */
+#define RCU_TUM_PERIOD 0.1
 int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count);
 
 /* count poses with positions uniform in the ball of the given radius about

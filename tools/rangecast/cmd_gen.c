@@ -13,7 +13,7 @@ static void usage(FILE *f)
 {
     fprintf(f,
         "Usage: rangecast gen --sphere N [--radius R] -o FILE.ply\n"
-        "       rangecast gen --poses N [--radius R] [--seed S] [--center x,y,z] -o FILE.bin\n"
+        "       rangecast gen --poses N [--radius R] [--seed S] [--center x,y,z] -o FILE.bin|FILE.tum\n"
         "       rangecast gen --demo-map -o FILE.ply\n"
         "\n"
         "  --sphere N     closed UV sphere of about N triangles (1k, 10k, 100k, 1M, 10M ...),\n"
@@ -21,7 +21,8 @@ static void usage(FILE *f)
         "  --poses N      N poses uniform in the ball of radius R (default 10 m) about\n"
         "                 --center (default 0,0,0), uniformly random orientations, from\n"
         "                 --seed S (default 1): the benchmark poses, identical on every\n"
-        "                 platform. File: float32 LE x y z qx qy qz qw per pose.\n"
+        "                 platform. File: float32 LE x y z qx qy qz qw per pose, or for\n"
+        "                 .tum/.txt a TUM trajectory: lines 'timestamp x y z qx qy qz qw'.\n"
         "  --demo-map     the demo warehouse\n"
         "  -o FILE        output file\n"
         "  -h, --help     this text\n"
@@ -89,10 +90,17 @@ int rcp_cmd_gen(int argc, char **argv)
         st = rcu_poses_write(out, p, poses);
         free(p);
         if (st != 0) return rcp_fail(cmd, "%s", rcu_last_error());
-        printf("%s: %s poses, radius %g m about (%g, %g, %g), seed %llu (%s bytes)\n", out,
-               rcp_thousands(poses, n1, sizeof n1), have_radius ? (double)radius : 10.0, (double)center[0],
-               (double)center[1], (double)center[2], (unsigned long long)seed,
-               rcp_thousands((uint64_t)poses * 28u, n2, sizeof n2));
+        {
+            char ext[8];
+            rcu_path_extension(out, ext, sizeof ext);
+            printf("%s: %s poses, radius %g m about (%g, %g, %g), seed %llu (", out,
+                   rcp_thousands(poses, n1, sizeof n1), have_radius ? (double)radius : 10.0, (double)center[0],
+                   (double)center[1], (double)center[2], (unsigned long long)seed);
+            if (strcmp(ext, "tum") == 0 || strcmp(ext, "txt") == 0)
+                printf("a TUM trajectory, %g s apart)\n", RCU_TUM_PERIOD);
+            else
+                printf("%s bytes)\n", rcp_thousands((uint64_t)poses * 28u, n2, sizeof n2));
+        }
     } else {
         rcu_mesh m;
         int st;
