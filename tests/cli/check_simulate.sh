@@ -115,6 +115,11 @@ run 0 "" "$RC" gen --poses 3 --radius 10 --seed 7 -o poses.tum
 [ "$(grep -vc '^#' poses.tum)" -eq 3 ] || fail "poses.tum does not hold 3 poses"
 run 0 "" "$RC" simulate --map sphere.ply --poses poses.tum -o three_tum.ply --fields range $BACKEND
 cmp three.ply three_tum.ply || fail "the TUM trajectory's cloud differs from the raw poses'"
+# The map copied into the arena (--mesh copy: its vertices renumbered in leaf
+# order): the same cloud.
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three_copy.ply --fields range --mesh copy $BACKEND
+cmp three.ply three_copy.ply || fail "the copied map's cloud differs from the referenced map's"
+run 2 "--mesh: expected reference or copy, got 'foo'" "$RC" simulate --map sphere.ply --pose 0,0,0 -o r.pcd --mesh foo
 printf '0.0 1 2 3 0 0 0 1\n0.1 1 2 3 0 0 1\n' >short.tum
 run 1 "short.tum:2: 7 numbers" "$RC" simulate --map sphere.ply --poses short.tum -o q.pcd
 
@@ -233,7 +238,7 @@ run 1 "o.p" limited "$RC" simulate --map sphere.ply --pose 0,0,0 -o o.ply --imag
 [ ! -e o.png ] && [ ! -e o.ppm ] || fail "a half-written range image was left behind"
 run 1 "n.bin: write error" limited "$RC" bench --map sphere.ply --poses poses.bin --repeat 1 --ranges-out n.bin \
     $BACKEND
-for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply p.pcd q.pcd; do
+for f in a.pcd b.pcd c.pcd d.xyz e.pcd f.pcd g.pcd i.pcd j.pcd k.pcd l.pcd m.ply n.bin o.ply p.pcd q.pcd r.pcd; do
     [ ! -e "$f" ] || fail "$f was written by a failed run"
     [ ! -e "$f.body.partial" ] || fail "a failed run left $f.body.partial"
 done

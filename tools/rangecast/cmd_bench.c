@@ -307,13 +307,7 @@ static int parse_args(int argc, char **argv, bench_args *a)
         } else if (strcmp(argv[i], "--results-on-device") == 0) {
             a->on_device = 1;
         } else if (OPT("--mesh")) {
-            if (r < 0) return -1;
-            if (strcmp(v, "reference") == 0)
-                rcp_mesh_flags = RC_MESH_REFERENCE;
-            else if (strcmp(v, "copy") == 0)
-                rcp_mesh_flags = RC_MESH_COPY;
-            else
-                return rcp_usage_error(cmd, "--mesh: expected reference or copy, got '%s'", v), -1;
+            if (r < 0 || rcp_parse_mesh_mode(cmd, v) != 0) return -1;
         } else if (OPT("--meshes")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &rcp_mesh_parts) != 0 || rcp_mesh_parts == 0)

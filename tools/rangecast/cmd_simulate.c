@@ -42,6 +42,10 @@ static void usage(FILE *f)
         "                      by its pixel_shift_by_row (as Ouster's SDK shows a frame)\n"
         "  --backend B         auto (default), bvh, embree, vulkan\n"
         "  --threads N         worker threads, 0 = all CPUs (default)\n"
+        "  --mesh M            reference (default): the map's arrays used in place; copy:\n"
+        "                      copied into the arena (RC_MESH_COPY), its vertices renumbered\n"
+        "                      in the tree's leaf order (faster on a map exported in a poor\n"
+        "                      vertex order)\n"
         "  --poses-per-call N  poses an rc_simulate call takes, each call's returns then\n"
         "                      written to OUT (default: as many as 128 MiB of results hold,\n"
         "                      321 VLP-16 scans), so a trajectory need not fit in memory\n"
@@ -160,6 +164,8 @@ static int parse_args(int argc, char **argv, sim_args *a)
             a->sensor_name = v;
         } else if (OPT("--backend")) {
             if (r < 0 || rcp_parse_backend(cmd, v, &a->backend) != 0) return -1;
+        } else if (OPT("--mesh")) {
+            if (r < 0 || rcp_parse_mesh_mode(cmd, v) != 0) return -1;
         } else if (OPT("--poses-per-call")) {
             if (r < 0) return -1;
             if (rcp_parse_u32(v, &a->poses_per_call) != 0 || a->poses_per_call == 0)

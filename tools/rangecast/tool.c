@@ -227,6 +227,17 @@ const char *rcp_build_quality_name(uint32_t quality)
 
 uint32_t rcp_build_quality = RC_BUILD_BALANCED;
 uint32_t rcp_mesh_flags = RC_MESH_REFERENCE;
+
+int rcp_parse_mesh_mode(const char *cmd, const char *value)
+{
+    if (strcmp(value, "reference") == 0)
+        rcp_mesh_flags = RC_MESH_REFERENCE;
+    else if (strcmp(value, "copy") == 0)
+        rcp_mesh_flags = RC_MESH_COPY;
+    else
+        return rcp_usage_error(cmd, "--mesh: expected reference or copy, got '%s'", value), -1;
+    return 0;
+}
 uint32_t rcp_mesh_parts = 1;
 
 static const char *const sensor_names[] = {"vlp16",       "vlp16-360", "os1-64", "d435",

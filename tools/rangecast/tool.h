@@ -88,9 +88,12 @@ extern const char *rcp_device;
 extern uint32_t rcp_context_flags;
 /* --build-quality of bench: the scene's rc_scene_desc.build_quality (RC_BUILD_*). */
 extern uint32_t rcp_build_quality;
-/* --mesh of bench: how the map's mesh is handed in, RC_MESH_REFERENCE (the
- * default: used in place) or RC_MESH_COPY (copied into the arena). */
+/* --mesh of bench and simulate: how the map's mesh is handed in,
+ * RC_MESH_REFERENCE (the default: used in place) or RC_MESH_COPY (copied into
+ * the arena). rcp_parse_mesh_mode sets it from the option's value ("reference"
+ * or "copy"); -1 after a usage error naming cmd. */
 extern uint32_t rcp_mesh_flags;
+int rcp_parse_mesh_mode(const char *cmd, const char *value);
 /* --meshes of bench: the map cut into this many meshes of consecutive
  * triangles, each a geometry with its own vertices (rcu_mesh_split); 1 = the
  * map as one mesh. */
