@@ -17,10 +17,10 @@
 # seed.
 # Installs clang, its libFuzzer runtime and libcjson-dev (tools/setup-deps.sh
 # fuzz), or prints the apt-get line when not root.
-# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace).
+# Variables: FUZZ_SECONDS, FUZZ_TARGETS (default: baked ply ouster trace tum).
 
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS ?= baked ply ouster trace
+FUZZ_TARGETS ?= baked ply ouster trace tum
 FUZZ_BUILD := $(BUILD)-fuzz
 
 .PHONY: fuzz
