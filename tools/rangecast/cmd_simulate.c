@@ -321,7 +321,7 @@ int rcp_cmd_simulate(int argc, char **argv)
     if (chunk > pose_count) chunk = pose_count;
     /* results a call: 29 bytes a ray at most (points, normals, range, hit) */
     if ((uint64_t)chunk * rays * 29u > (uint64_t)(SIZE_MAX / 2u)) {
-        rcp_fail(cmd, "--poses-per-call %u: the results of %u scans do not fit in this machine's memory", chunk,
+        rcp_fail(cmd, "--poses-per-call %u: the results of that many scans do not fit in this machine's memory",
                  chunk);
         goto done;
     }
