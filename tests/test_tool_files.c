@@ -20,6 +20,7 @@
 #include "cloud.h"
 #include "ouster_frame.h"
 #include "poses.h"
+#include "scan_names.h"
 #include "util.h"
 
 static void write_bytes(const char *path, const void *data, size_t size)
@@ -417,6 +418,32 @@ static void test_cloud_stream(void **state)
     rcu_cloud_free(&c);
 }
 
+/* Per-scan names (scan_names.h): one %d or %0Nd becomes the index; any
+ * other '%' is refused, and a name that does not fit fails. */
+static void test_scan_names(void **state)
+{
+    char name[32];
+    (void)state;
+    assert_int_equal(rcu_scan_pattern("cloud.pcd"), 0);
+    assert_int_equal(rcu_scan_pattern("scans/scan_%05d.pcd"), 1);
+    assert_int_equal(rcu_scan_pattern("%d.ply"), 1);
+    assert_int_equal(rcu_scan_pattern("a_%s.pcd"), -1);
+    expect_message("one %d or %0Nd");
+    assert_int_equal(rcu_scan_pattern("a_%d_%d.pcd"), -1);
+    assert_int_equal(rcu_scan_pattern("a_%00d.pcd"), -1);
+    assert_int_equal(rcu_scan_pattern("a_%5d.pcd"), -1);
+    assert_int_equal(rcu_scan_pattern("100%.pcd"), -1);
+    assert_int_equal(rcu_scan_name("scans/scan_%05d.pcd", 42, name, sizeof name), 0);
+    assert_string_equal(name, "scans/scan_00042.pcd");
+    assert_int_equal(rcu_scan_name("%d.ply", 1234567, name, sizeof name), 0);
+    assert_string_equal(name, "1234567.ply");
+    assert_int_equal(rcu_scan_name("s%02d", 123, name, sizeof name), 0);
+    assert_string_equal(name, "s123");
+    assert_int_equal(rcu_scan_name("a_long_prefix_%09d.pcd", 1, name, 20), -1);
+    expect_message("too long");
+    assert_int_equal(rcu_scan_name("plain.pcd", 1, name, sizeof name), -1);
+}
+
 /* An Ouster frame: the column window (wrapping or not) and destaggering as
  * the SDK does it, on a 3 x 5 field with known values. */
 static void test_ouster_frame(void **state)
@@ -468,6 +495,7 @@ int main(void)
         cmocka_unit_test(test_cloud_map_frame),
         cmocka_unit_test(test_cloud_files),
         cmocka_unit_test(test_cloud_stream),
+        cmocka_unit_test(test_scan_names),
         cmocka_unit_test(test_ouster_frame),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

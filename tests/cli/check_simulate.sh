@@ -109,6 +109,19 @@ run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o three2b.pcd --asci
     --poses-per-call 2 $BACKEND
 cmp three2.pcd three2b.pcd || fail "three2.pcd written two scans at a time differs"
 ls ./*.partial >/dev/null 2>&1 && fail "a body file was left behind: $(ls ./*.partial)"
+# A file a scan (-o with one %d or %0Nd): each holds its scan's records, the
+# slice of three.ply's; only as many files as poses; other '%' refused.
+run 0 "" "$RC" simulate --map sphere.ply --poses poses.bin -o 'scan_%02d.ply' --fields range --poses-per-call 2 \
+    $BACKEND
+for k in 0 1 2; do
+    grep -q "^element vertex 14400" "scan_0$k.ply" || fail "scan_0$k.ply: PLY vertex count"
+    h=$(awk '{ n += length($0) + 1 } /^end_header/ { print n; exit }' "scan_0$k.ply")
+    tail -c +$((h + 1)) "scan_0$k.ply" >got.bin
+    tail -c +$((header + 1 + k * 14400 * 16)) three.ply | head -c $((14400 * 16)) >want.bin
+    cmp got.bin want.bin || fail "scan_0$k.ply is not scan $k of three.ply"
+done
+[ ! -e scan_03.ply ] || fail "a fourth scan file for three poses"
+run 2 "one %d or %0Nd" "$RC" simulate --map sphere.ply --pose 0,0,0 -o 'bad_%s.pcd'
 # The same poses as a TUM trajectory (gen writes one for .tum; lines
 # 'timestamp x y z qx qy qz qw'): the same cloud. A bad line is named.
 run 0 "" "$RC" gen --poses 3 --radius 10 --seed 7 -o poses.tum

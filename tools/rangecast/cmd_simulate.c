@@ -15,6 +15,7 @@
 #include "poses.h"
 #include "range_image.h"
 #include "reference.h"
+#include "scan_names.h"
 #include "tool.h"
 #include "util.h"
 
@@ -49,7 +50,9 @@ static void usage(FILE *f)
         "  --poses-per-call N  poses an rc_simulate call takes, each call's returns then\n"
         "                      written to OUT (default: as many as 128 MiB of results hold,\n"
         "                      321 VLP-16 scans), so a trajectory need not fit in memory\n"
-        "  -o, --output OUT    .ply or .pcd (binary unless --ascii)\n"
+        "  -o, --output OUT    .ply or .pcd (binary unless --ascii); a name with one %%d or\n"
+        "                      %%0Nd (scans/scan_%%05d.pcd) writes a file a scan, the pose's\n"
+        "                      index (from 0) in its name\n"
         "  --ascii             write ascii PLY/PCD\n"
         "  --frame F           sensor (default: each scan in its own sensor frame) or map\n"
         "  --fields LIST       extra per-point fields, comma-separated: range, intensity, ring\n"
@@ -69,6 +72,7 @@ typedef struct sim_args {
     const char *map, *poses_path, *out, *image, *sensor_name;
     const char *ouster_path; /* --sensor ouster:FILE, else NULL */
     int have_pose, ascii, map_frame;
+    int per_scan; /* -o is a pattern (scan_names.h): a file a scan */
     rc_pose pose;
     uint32_t preset, backend, threads, fields, image_mode;
     uint32_t poses_per_call; /* 0: by SIM_CHUNK_BYTES */
@@ -222,8 +226,39 @@ static int parse_args(int argc, char **argv, sim_args *a)
         rcu_path_extension(a->out, ext, sizeof ext);
         if (strcmp(ext, "ply") != 0 && strcmp(ext, "pcd") != 0)
             return rcp_usage_error(cmd, "-o %s: the point cloud must be .ply or .pcd", a->out), -1;
+        if ((a->per_scan = rcu_scan_pattern(a->out)) < 0) return rcp_usage_error(cmd, "-o %s", rcu_last_error()), -1;
     }
     if (a->preset == 0 && !a->ouster_path) a->preset = rc_preset_from_name(a->sensor_name);
+    return 0;
+}
+
+/* A file a scan (-o with a pattern): the batch's scans, poses first .. first
+ * + view->pose_count - 1, each to the name its pose index gives; adds their
+ * returns to *returns. 0, or -1 with rcu_last_error() (the failed file is not
+ * left behind; the scans' files before it are whole). */
+static int write_scans(const sim_args *a, const rcu_scan_view *view, uint32_t first, size_t *returns)
+{
+    char name[4096];
+    uint32_t s;
+    for (s = 0; s < view->pose_count; ++s) {
+        const size_t at = (size_t)s * view->rays_per_scan;
+        rcu_scan_view one = *view;
+        rcu_cloud_stream st;
+        one.pose_count = 1;
+        one.points = view->points + 3u * at;
+        one.hits = view->hits ? view->hits + at : NULL;
+        one.ranges = view->ranges ? view->ranges + at : NULL;
+        one.normals = view->normals ? view->normals + 3u * at : NULL;
+        one.poses = view->poses ? view->poses + s : NULL;
+        if (rcu_scan_name(a->out, first + s, name, sizeof name) != 0) return -1;
+        if (rcu_cloud_stream_open(&st, name, a->fields, a->ascii) != 0) return -1;
+        if (rcu_cloud_stream_append(&st, &one) != 0) {
+            rcu_cloud_stream_abort(&st);
+            return -1;
+        }
+        *returns += st.count;
+        if (rcu_cloud_stream_close(&st) != 0) return -1;
+    }
     return 0;
 }
 
@@ -335,11 +370,13 @@ int rcp_cmd_simulate(int argc, char **argv)
     }
     /* the cloud goes to the file a batch at a time: a long trajectory's
      * scans need not fit in memory */
-    if (rcu_cloud_stream_open(&out, a.out, a.fields, a.ascii) != 0) {
-        rcp_fail(cmd, "%s", rcu_last_error());
-        goto done;
+    if (!a.per_scan) {
+        if (rcu_cloud_stream_open(&out, a.out, a.fields, a.ascii) != 0) {
+            rcp_fail(cmd, "%s", rcu_last_error());
+            goto done;
+        }
+        out_open = 1;
     }
-    out_open = 1;
     for (p = 0; p < pose_count; p += chunk) {
         uint32_t n = pose_count - p < chunk ? pose_count - p : chunk;
         rc_results res = rc_results_default();
@@ -374,7 +411,12 @@ int rcp_cmd_simulate(int argc, char **argv)
         view.pose_count = n;
         view.poses = a.map_frame ? poses + p : NULL;
         view.sensor_to_base = &ref.mount;
-        if (rcu_cloud_stream_append(&out, &view) != 0) {
+        if (a.per_scan) {
+            if (write_scans(&a, &view, p, &returns) != 0) {
+                rcp_fail(cmd, "%s", rcu_last_error());
+                goto done;
+            }
+        } else if (rcu_cloud_stream_append(&out, &view) != 0) {
             rcp_fail(cmd, "%s", rcu_last_error());
             goto done;
         }
@@ -396,13 +438,15 @@ int rcp_cmd_simulate(int argc, char **argv)
             if (write_image(cmd, a.image, a.preset, &si, shown, a.image_mode) != 0) goto done;
         }
     }
-    returns = out.count;
-    out_open = 0;
-    if (rcu_cloud_stream_close(&out) != 0) {
-        rcp_fail(cmd, "%s", rcu_last_error());
-        goto done;
+    if (out_open) {
+        returns = out.count;
+        out_open = 0;
+        if (rcu_cloud_stream_close(&out) != 0) {
+            rcp_fail(cmd, "%s", rcu_last_error());
+            goto done;
+        }
     }
-    if (pose_count > 1 && !a.map_frame)
+    if (pose_count > 1 && !a.map_frame && !a.per_scan)
         fprintf(stderr, "rangecast simulate: note: %u scans written each in its own sensor frame "
                         "(--frame map places them in the map)\n", pose_count);
     printf("%s: %u scan%s x %s rays, %s returns (%.1f%%), simulated in %.3f s (%.0f scans/s, %s, %u threads) -> %s",
@@ -410,6 +454,7 @@ int rcp_cmd_simulate(int argc, char **argv)
            rcp_thousands(returns, n2, sizeof n2),
            100.0 * (double)returns / ((double)pose_count * rays), t_sim,
            t_sim > 0 ? pose_count / t_sim : 0.0, rc_backend_name(w.backend), w.threads, a.out);
+    if (a.per_scan) printf(" (%u files)", pose_count);
     if (a.image) printf(", %s", a.image);
     printf("\n");
     rc = RCP_EXIT_OK;
