@@ -240,6 +240,9 @@ if [ -c /dev/full ]; then
     ln -s /dev/full full.pcd
     run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd
     [ -c /dev/full ] || fail "/dev/full was removed"
+    # the image is written before the cloud fails: the failed run removes it
+    run 1 "full.pcd: write error" "$RC" simulate --map sphere.ply --pose 0,0,0 -o full.pcd --image full.png
+    [ ! -e full.png ] && [ ! -e full.ppm ] || fail "a failed run left its range image"
 fi
 # A write that fails halfway (the file size limit, with SIGXFSZ ignored so
 # the write returns EFBIG): exit 1 and no half-written file left behind.

@@ -262,22 +262,23 @@ static int write_scans(const sim_args *a, const rcu_scan_view *view, uint32_t fi
     return 0;
 }
 
-/* Writes the range image of one scan; 0 or RCP_EXIT_FAIL (message printed). */
+/* Writes the range image of one scan, its file's name into written (the
+ * PPM's where the program has no libpng); 0 or RCP_EXIT_FAIL (message
+ * printed). */
 static int write_image(const char *cmd, const char *path, uint32_t preset, const rc_sensor_info *si,
-                       const float *ranges, uint32_t mode)
+                       const float *ranges, uint32_t mode, char *written, size_t written_size)
 {
     rcp_image_options io;
-    char written[4096];
     int st;
     rcp_image_options_for(si->model, si->rows, si->columns, &io);
     io.mode = mode;
     if (si->model == RC_SENSOR_O1DN && si->rows <= 1 && mode == RCP_IMAGE_COLOR) {
         rcu_preset_rays ref;
         if (rcu_preset_rays_f64(preset, &ref) != 0) return rcp_fail(cmd, "%s", rcu_last_error());
-        st = rcp_scatter_image_write(path, ranges, ref.dirs, ref.rays, 640, &io, written, sizeof written);
+        st = rcp_scatter_image_write(path, ranges, ref.dirs, ref.rays, 640, &io, written, written_size);
         rcu_preset_rays_free(&ref);
     } else {
-        st = rcp_range_image_write(path, ranges, si->rows, si->columns, &io, written, sizeof written);
+        st = rcp_range_image_write(path, ranges, si->rows, si->columns, &io, written, written_size);
     }
     if (st != 0) return rcp_fail(cmd, "%s", rcu_last_error());
     if (!rcp_range_image_has_png())
@@ -304,6 +305,7 @@ int rcp_cmd_simulate(int argc, char **argv)
     size_t returns = 0;
     int rc = RCP_EXIT_FAIL;
     char n1[32], n2[32];
+    char image_written[4096] = ""; /* the image's file once written: a failed run removes it */
 
     if (parse_args(argc, argv, &a) != 0) return RCP_EXIT_USAGE;
     memset(&w, 0, sizeof w);
@@ -435,7 +437,11 @@ int rcp_cmd_simulate(int argc, char **argv)
                 rcu_ouster_destagger(ranges, image, ou.height, ou.width, ou.pixel_shift);
                 shown = image;
             }
-            if (write_image(cmd, a.image, a.preset, &si, shown, a.image_mode) != 0) goto done;
+            if (write_image(cmd, a.image, a.preset, &si, shown, a.image_mode, image_written, sizeof image_written) !=
+                0) {
+                image_written[0] = '\0';
+                goto done;
+            }
         }
     }
     if (out_open) {
@@ -459,6 +465,9 @@ int rcp_cmd_simulate(int argc, char **argv)
     printf("\n");
     rc = RCP_EXIT_OK;
 done:
+    /* a failed run leaves none of its outputs: the image written before
+     * the cloud failed goes too (a file a scan: those before it are whole) */
+    if (rc != RCP_EXIT_OK && image_written[0]) rcu_remove_partial(image_written);
     rcp_world_destroy(&w);
     rcu_preset_rays_free(&ref);
     rcp_rays_free(&ou);
