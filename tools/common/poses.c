@@ -88,8 +88,7 @@ void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const f
     }
 }
 
-/* 1 for a path the TUM reader and writer take (tum.h). */
-static int is_tum(const char *path)
+int rcu_poses_is_tum(const char *path)
 {
     char ext[8];
     rcu_path_extension(path, ext, sizeof ext);
@@ -101,7 +100,7 @@ int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count)
     unsigned char *data;
     size_t size, n, i;
     rc_pose *poses;
-    if (is_tum(path)) return rcu_tum_read(path, out, count);
+    if (rcu_poses_is_tum(path)) return rcu_tum_read(path, out, count);
     if (rcu_read_file(path, &data, &size) != 0) return -1;
     if (size == 0) {
         free(data);
@@ -162,7 +161,7 @@ int rcu_poses_write(const char *path, const rc_pose *poses, uint32_t count)
 {
     FILE *f;
     uint32_t i;
-    if (is_tum(path)) return rcu_tum_write(path, poses, count, RCU_TUM_PERIOD);
+    if (rcu_poses_is_tum(path)) return rcu_tum_write(path, poses, count, RCU_TUM_PERIOD);
     f = fopen(path, "wb");
     if (!f) return rcu_fail("%s: %s", path, strerror(errno));
     for (i = 0; i < count; i++) {

@@ -20,6 +20,10 @@
  * A path ending in .tum or .txt is read as a TUM trajectory (tum.h). */
 int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count);
 
+/* 1 when rcu_poses_read and rcu_poses_write take path as a TUM trajectory
+ * (it ends in .tum or .txt). */
+int rcu_poses_is_tum(const char *path);
+
 /* Writes count poses; to a .tum or .txt path as a TUM trajectory, poses
  * RCU_TUM_PERIOD seconds apart (a spinning LiDAR's 10 Hz). */
 #define RCU_TUM_PERIOD 0.1

@@ -27,7 +27,6 @@ static int parse_line(const char *p, const char *end, double v[8])
         p = skip_separators(p);
         if (p >= end || *p == '\r') return n;
         if (n == 8) return 9;
-        errno = 0;
         v[n] = strtod(p, &next);
         /* strtod reads past the line only through spaces it skips first;
          * skip_separators has taken those, so next stays on the line */

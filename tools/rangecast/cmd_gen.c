@@ -90,17 +90,13 @@ int rcp_cmd_gen(int argc, char **argv)
         st = rcu_poses_write(out, p, poses);
         free(p);
         if (st != 0) return rcp_fail(cmd, "%s", rcu_last_error());
-        {
-            char ext[8];
-            rcu_path_extension(out, ext, sizeof ext);
-            printf("%s: %s poses, radius %g m about (%g, %g, %g), seed %llu (", out,
-                   rcp_thousands(poses, n1, sizeof n1), have_radius ? (double)radius : 10.0, (double)center[0],
-                   (double)center[1], (double)center[2], (unsigned long long)seed);
-            if (strcmp(ext, "tum") == 0 || strcmp(ext, "txt") == 0)
-                printf("a TUM trajectory, %g s apart)\n", RCU_TUM_PERIOD);
-            else
-                printf("%s bytes)\n", rcp_thousands((uint64_t)poses * 28u, n2, sizeof n2));
-        }
+        printf("%s: %s poses, radius %g m about (%g, %g, %g), seed %llu (", out, rcp_thousands(poses, n1, sizeof n1),
+               have_radius ? (double)radius : 10.0, (double)center[0], (double)center[1], (double)center[2],
+               (unsigned long long)seed);
+        if (rcu_poses_is_tum(out))
+            printf("a TUM trajectory, %g s apart)\n", RCU_TUM_PERIOD);
+        else
+            printf("%s bytes)\n", rcp_thousands((uint64_t)poses * 28u, n2, sizeof n2));
     } else {
         rcu_mesh m;
         int st;
