@@ -88,6 +88,12 @@ void rcu_poses_random_about(uint32_t count, float radius, uint64_t seed, const f
     }
 }
 
+double rcu_pose_quaternion_norm(const rc_pose *pose)
+{
+    const float *q = pose->orientation;
+    return sqrt((double)q[0] * q[0] + (double)q[1] * q[1] + (double)q[2] * q[2] + (double)q[3] * q[3]);
+}
+
 int rcu_poses_is_tum(const char *path)
 {
     char ext[8];
@@ -125,27 +131,25 @@ int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count)
     }
     for (i = 0; i < n; i++) {
         const unsigned char *p = data + i * RCU_POSE_FILE_BYTES;
-        double norm2 = 0.0;
+        double norm;
         int k;
         for (k = 0; k < 3; k++) poses[i].position[k] = rcu_load_f32le(p + 4 * k);
-        for (k = 0; k < 4; k++) {
-            poses[i].orientation[k] = rcu_load_f32le(p + 12 + 4 * k);
-            norm2 += (double)poses[i].orientation[k] * poses[i].orientation[k];
-        }
+        for (k = 0; k < 4; k++) poses[i].orientation[k] = rcu_load_f32le(p + 12 + 4 * k);
+        norm = rcu_pose_quaternion_norm(&poses[i]);
         for (k = 0; k < 3; k++)
             if (!isfinite(poses[i].position[k])) break;
-        if (k < 3 || !isfinite(norm2)) {
+        if (k < 3 || !isfinite(norm)) {
             free(data);
             free(poses);
             return rcu_fail("%s: pose %zu (byte offset %zu) has a NaN or infinite value", path, i,
                             i * RCU_POSE_FILE_BYTES);
         }
-        if (fabs(sqrt(norm2) - 1.0) > 1e-3) {
+        if (fabs(norm - 1.0) > RCU_POSE_NORM_TOLERANCE) {
             rcu_fail("%s: pose %zu (byte offset %zu): quaternion (%g, %g, %g, %g) has norm %g, "
                      "not 1 (is the file x y z qx qy qz qw float32 little-endian?)",
                      path, i, i * RCU_POSE_FILE_BYTES, (double)poses[i].orientation[0],
                      (double)poses[i].orientation[1], (double)poses[i].orientation[2],
-                     (double)poses[i].orientation[3], sqrt(norm2));
+                     (double)poses[i].orientation[3], norm);
             free(data);
             free(poses);
             return -1;

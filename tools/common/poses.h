@@ -20,6 +20,12 @@
  * A path ending in .tum or .txt is read as a TUM trajectory (tum.h). */
 int rcu_poses_read(const char *path, rc_pose **out, uint32_t *count);
 
+/* The readers refuse a pose whose quaternion's norm is off 1 by more than
+ * this (a file of another layout or order, not rounding). */
+#define RCU_POSE_NORM_TOLERANCE 1e-3
+/* The norm of a pose's quaternion, in double. */
+double rcu_pose_quaternion_norm(const rc_pose *pose);
+
 /* 1 when rcu_poses_read and rcu_poses_write take path as a TUM trajectory
  * (it ends in .tum or .txt). */
 int rcu_poses_is_tum(const char *path);

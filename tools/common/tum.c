@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "poses.h"
 #include "util.h"
 
 /* Skips spaces, tabs and commas (not line ends). */
@@ -60,7 +61,7 @@ int rcu_tum_read(const char *path, rc_pose **out, uint32_t *count)
     while (p < end) {
         const char *eol = memchr(p, '\n', (size_t)(end - p));
         const char *first;
-        double v[8], norm2 = 0.0;
+        double v[8], norm;
         int k, got;
         if (!eol) eol = end;
         ++line;
@@ -70,36 +71,32 @@ int rcu_tum_read(const char *path, rc_pose **out, uint32_t *count)
             continue;
         }
         if (memchr(p, '\0', (size_t)(eol - p)) != NULL) {
-            free(data);
-            free(poses);
-            return rcu_fail("%s:%zu: a NUL byte (is this a raw pose file? those end in .bin)", path, line);
+            rcu_fail("%s:%zu: a NUL byte (is this a raw pose file? those end in .bin)", path, line);
+            goto fail;
         }
         got = parse_line(first, eol, v);
+        if (got < 0 || got > 8) {
+            rcu_fail("%s:%zu: %s (expected 'timestamp x y z qx qy qz qw')", path, line,
+                     got < 0 ? "not a number" : "more than 8 numbers");
+            goto fail;
+        }
         if (got != 8) {
-            free(data);
-            free(poses);
-            if (got < 0)
-                return rcu_fail("%s:%zu: not a number (expected 'timestamp x y z qx qy qz qw')", path, line);
-            if (got > 8) return rcu_fail("%s:%zu: more than 8 numbers (expected 'timestamp x y z qx qy qz qw')", path, line);
-            return rcu_fail("%s:%zu: %d number%s (expected 8: timestamp x y z qx qy qz qw)", path, line, got,
-                            got == 1 ? "" : "s");
+            rcu_fail("%s:%zu: %d number%s (expected 8: timestamp x y z qx qy qz qw)", path, line, got,
+                     got == 1 ? "" : "s");
+            goto fail;
         }
         for (k = 0; k < 8; ++k)
             if (!isfinite(v[k]) || (k > 0 && fabs(v[k]) > FLT_MAX)) {
-                free(data);
-                free(poses);
-                return rcu_fail("%s:%zu: value %d is not finite in float", path, line, k + 1);
+                rcu_fail("%s:%zu: value %d is not finite in float", path, line, k + 1);
+                goto fail;
             }
         for (k = 0; k < 3; ++k) poses[n].position[k] = (float)v[1 + k];
-        for (k = 0; k < 4; ++k) {
-            poses[n].orientation[k] = (float)v[4 + k];
-            norm2 += v[4 + k] * v[4 + k];
-        }
-        if (fabs(sqrt(norm2) - 1.0) > 1e-3) {
-            free(data);
-            free(poses);
-            return rcu_fail("%s:%zu: quaternion (%g, %g, %g, %g) has norm %g, not 1 (the order is qx qy qz qw)",
-                            path, line, v[4], v[5], v[6], v[7], sqrt(norm2));
+        for (k = 0; k < 4; ++k) poses[n].orientation[k] = (float)v[4 + k];
+        norm = rcu_pose_quaternion_norm(&poses[n]);
+        if (fabs(norm - 1.0) > RCU_POSE_NORM_TOLERANCE) {
+            rcu_fail("%s:%zu: quaternion (%g, %g, %g, %g) has norm %g, not 1 (the order is qx qy qz qw)", path,
+                     line, v[4], v[5], v[6], v[7], norm);
+            goto fail;
         }
         if (++n == UINT32_MAX) break;
         p = eol + 1;
@@ -112,6 +109,10 @@ int rcu_tum_read(const char *path, rc_pose **out, uint32_t *count)
     *out = poses;
     *count = (uint32_t)n;
     return 0;
+fail:
+    free(data);
+    free(poses);
+    return -1;
 }
 
 int rcu_tum_write(const char *path, const rc_pose *poses, uint32_t count, double period)
