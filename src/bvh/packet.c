@@ -811,6 +811,22 @@ static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uin
 }
 #endif
 
+/* 1 when every lane of e has since found a hit nearer than e's box, so its
+ * box tests would drop them all: tmin bounds the entry distances of its
+ * lanes from below, and the tmax of one lane (an entry of one lane, most of
+ * them deep in a large map), or P.tmax for several, their nearest hits from
+ * above. The lane's own tmax drops what P.tmax, the packet's largest,
+ * keeps (the lone lane's pop does the same). */
+static RC__FORCE_INLINE int entry_beyond(const packet_trav *T, const packet_entry *e)
+{
+#if !defined(__OPTIMIZE_SIZE__)
+    /* (-Os builds keep to P.tmax: these 32 bytes would take the static core
+     * past its budget; the same results) */
+    if (!(e->mask & (e->mask - 1u))) return e->tmin > T->L.tmax[rc__lowest_bit(e->mask)] * RC__SLAB_FAR_SCALE;
+#endif
+    return T->P.usable && e->tmin > T->P.tmax * RC__SLAB_FAR_SCALE;
+}
+
 /* Handles T's current node or leaf and moves to the next entry. With
  * interleaved set (a constant at every call) it works in turns as described
  * above. 0 when the traversal is over (prim ids settled). */
@@ -979,11 +995,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             return 0;
         }
         --T->sp;
-        /* an entry whose bound lies beyond every lane's nearest hit is
-         * dropped here, as its box tests would drop every lane (tmin bounds
-         * the entry distances of its lanes from below, P.tmax their tmax
-         * from above) */
-    } while (T->P.usable && T->stack[T->sp].tmin > T->P.tmax * RC__SLAB_FAR_SCALE);
+    } while (entry_beyond(T, &T->stack[T->sp]));
     if (interleaved) T->staged = 0;
     T->child = T->stack[T->sp].child;
     T->count = T->stack[T->sp].count;
