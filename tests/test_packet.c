@@ -66,12 +66,29 @@ typedef struct test_map {
     const rc__mesh *mesh;
 } test_map;
 
+/* 1: the box twice over in the mesh, so each hit on it ties with its copy
+ * (the tie rule keeps the smaller prim id, wherever the traversal met it) */
+static int map_box_twice;
+
 static void map_open(test_map *t)
 {
     rc_scene *scene;
     assert_int_equal(rcu_mesh_uv_sphere(20.0f, 200, 100, &t->m), 0);
     assert_int_equal(rcu_mesh_box(box_lo, box_hi, &t->box), 0);
     assert_int_equal(rcu_mesh_append(&t->m, &t->box), 0);
+    if (map_box_twice) {
+        /* and a third time 0.2 mm further on each axis: faces a hair
+         * apart, so a box entered just before a lane's nearest hit holds a
+         * nearer one */
+        static const float shift = 0.0002f;
+        const float lo2[3] = {box_lo[0] + shift, box_lo[1] + shift, box_lo[2] + shift};
+        const float hi2[3] = {box_hi[0] + shift, box_hi[1] + shift, box_hi[2] + shift};
+        rcu_mesh near_box;
+        assert_int_equal(rcu_mesh_append(&t->m, &t->box), 0);
+        assert_int_equal(rcu_mesh_box(lo2, hi2, &near_box), 0);
+        assert_int_equal(rcu_mesh_append(&t->m, &near_box), 0);
+        rcu_mesh_free(&near_box);
+    }
     t->ctx = rct_context(RC_BACKEND_BVH, 1, 0);
     scene = rct_scene_mesh(t->ctx, &t->m, RC_MESH_REFERENCE);
     t->mesh = &scene->geoms[0].mesh;
@@ -531,6 +548,20 @@ static void test_pending_prims_equal_single(void **state)
     assert_true(pending_seen > 0);
 }
 
+/* Ties within one mesh (the box and its copy): a box whose entry distance
+ * rounds just above a lane's nearest t may hold the tie that wins, so every
+ * traversal keeps the slack of the box test where it drops entries (packets,
+ * lone lanes, lone lanes taking turns) */
+static void test_ties_equal_single(void **state)
+{
+    (void)state;
+    map_box_twice = 1;
+    packet_equals_single(&selected, 0);
+    packets_in_turns_equal_single(&selected, 0);
+    packets_in_turns_equal_single(&selected, RC__PACKET_OWN_ORIGINS);
+    map_box_twice = 0;
+}
+
 /* A tie with a hit another mesh's search left pending: the key decides by
  * geometry (the pending hit's 0 before 1) without resolving the pending prim
  * against this mesh's refs, which its slot does not index (one entry here) */
@@ -609,6 +640,7 @@ int main(void)
                                        cmocka_unit_test(test_own_origins_equal_single),
                                        cmocka_unit_test(test_pending_prims_equal_single),
                                        cmocka_unit_test(test_pending_prim_from_another_mesh),
+                                       cmocka_unit_test(test_ties_equal_single),
                                        cmocka_unit_test(test_both_builds_equal_single),
                                        cmocka_unit_test(test_packet_meshes_equal_meshwise),
                                        cmocka_unit_test(test_scene_packet_equals_items),
