@@ -753,50 +753,64 @@ static RC__FORCE_INLINE void leaf_lane_offer(packet_trav *T, const rc__mesh *mes
  * aarch64 would take that core past its 200 KB budget, docs/benchmarks.md);
  * there a lone lane stays in the packet, with the same results. */
 #define RC__PACKET_LONE_LANE 1
+/* A lone lane's node: the children the lane meets sorted onto e, farthest
+ * first (the nearest, on top, is visited next; of equal ones the earlier),
+ * each fetched now. Returns their count. */
+static RC__FORCE_INLINE uint32_t lone_node(const packet_trav *T, const rc__mesh *mesh, uint32_t lane, uint32_t child,
+                                           rc__wide_entry *e)
+{
+    const rc__wnode *nodes = mesh->wide;
+    const rc__wnode *n = &nodes[child];
+    const rc__ray *ray = &T->rays[lane];
+    float tn[4] RC__ALIGN16;
+    uint32_t met = rc__wide_box_test(n, T->L.near_row, ray->org, ray->inv_dir, T->L.tmax[lane], tn), m = 0;
+    while (met) {
+        const uint32_t c = rc__lowest_bit(met);
+        met &= met - 1u;
+        if (n->child[c] == RC__WIDE_EMPTY) continue;
+        rc__prefetch_next(nodes, mesh->leaf_tris, n->child[c], n->count[c]);
+        m = rc__wide_add_sorted(e, m, n, c, tn);
+    }
+    return m;
+}
+
+/* A lone lane's leaf (child, count): its triangles tested and the hits
+ * offered. Sets *shrunk when the lane's tmax shrank. */
+static RC__FORCE_INLINE void lone_leaf(packet_trav *T, const rc__mesh *mesh, uint32_t lane, uint32_t child,
+                                       uint32_t count, uint32_t geom, uint32_t inst, int *shrunk)
+{
+    const rc__ray *ray = &T->rays[lane];
+    const float *vt[4][3];
+    const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, count, vt);
+    rc__leaf4_out lo;
+    uint32_t known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
+#if defined(RC__PACKET_AVX2)
+    if (n_tri == 4u)
+        rc__leaf4_test(ray, (const float *const(*)[3])vt, 4u, &lo);
+    else
+#endif
+        rc__leaf4_test(ray, (const float *const(*)[3])vt, n_tri, &lo);
+    leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, shrunk);
+}
+
 static RC__FORCE_INLINE void lone_lane(packet_trav *T, const rc__mesh *mesh, uint32_t lane, uint32_t child,
                                        uint32_t count, uint32_t geom, uint32_t inst, int *shrunk)
 {
-    const rc__wnode *nodes = mesh->wide;
-    const rc__ray *ray = &T->rays[lane];
     rc__wide_entry stack[PACKET_STACK + 4u]; /* room for one node's children past the end */
     uint32_t sp = 0;
     for (;;) {
         if (count == 0) {
-            const rc__wnode *n = &nodes[child];
-            float tn[4] RC__ALIGN16;
-            uint32_t met = rc__wide_box_test(n, T->L.near_row, ray->org, ray->inv_dir, T->L.tmax[lane], tn);
-            if (met) {
-                /* sorted onto the stack, farthest first; the nearest, on
-                 * top, is visited next (of equal ones the earlier) */
-                rc__wide_entry *const e = stack + sp;
-                uint32_t m = 0;
-                while (met) {
-                    const uint32_t c = rc__lowest_bit(met);
-                    met &= met - 1u;
-                    if (n->child[c] == RC__WIDE_EMPTY) continue;
-                    rc__prefetch_next(nodes, mesh->leaf_tris, n->child[c], n->count[c]);
-                    m = rc__wide_add_sorted(e, m, n, c, tn);
-                }
-                if (m > 0) {
-                    child = e[m - 1].child;
-                    count = e[m - 1].count;
-                    sp += m - 1u;
-                    if (RC__UNLIKELY(sp > PACKET_STACK)) sp = PACKET_STACK;
-                    continue;
-                }
+            rc__wide_entry *const e = stack + sp;
+            const uint32_t m = lone_node(T, mesh, lane, child, e);
+            if (m > 0) {
+                child = e[m - 1].child;
+                count = e[m - 1].count;
+                sp += m - 1u;
+                if (RC__UNLIKELY(sp > PACKET_STACK)) sp = PACKET_STACK;
+                continue;
             }
         } else {
-            const float *vt[4][3];
-            const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, count, vt);
-            rc__leaf4_out lo;
-            uint32_t known = mesh->flats_folded ? 0xFu : 0u, flat = 0;
-#if defined(RC__PACKET_AVX2)
-            if (n_tri == 4u)
-                rc__leaf4_test(ray, (const float *const(*)[3])vt, 4u, &lo);
-            else
-#endif
-                rc__leaf4_test(ray, (const float *const(*)[3])vt, n_tri, &lo);
-            leaf_lane_offer(T, mesh, vt, child, lane, &lo, &known, &flat, geom, inst, shrunk);
+            lone_leaf(T, mesh, lane, child, count, geom, inst, shrunk);
         }
         /* pop (with the box test's slack, as the single-ray traversal: a box
          * whose entry rounds just above t may hold a tie) */
@@ -829,9 +843,19 @@ static RC__FORCE_INLINE int entry_beyond(const packet_trav *T, const packet_entr
 
 /* Handles T's current node or leaf and moves to the next entry. With
  * interleaved set (a constant at every call) it works in turns as described
- * above. 0 when the traversal is over (prim ids settled). */
+ * above; with a pool (below) each subtree one lane alone meets goes there.
+ * 0 when the traversal is over (prim ids settled, except with a pool: its
+ * lanes may still be searching, and the caller settles them). */
+#if defined(RC__PACKET_LONE_LANE)
+typedef struct lone_pool lone_pool;
+static void pool_add(lone_pool *pool, packet_trav *T, uint32_t lane, uint32_t child, uint32_t count,
+                     const rc__mesh *mesh, uint32_t geom, uint32_t inst);
+#else
+typedef void lone_pool;
+#endif
+
 static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint32_t geom, uint32_t inst,
-                                      int interleaved)
+                                      int interleaved, lone_pool *pool)
 {
     const rc__wnode *nodes = mesh->wide;
     packet_lanes *L = &T->L;
@@ -845,9 +869,13 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
 #if defined(RC__PACKET_LONE_LANE)
     if (!interleaved && !(mask & (mask - 1u))) {
         /* one live lane: the rest of this subtree is that lane's alone */
-        int shrunk = 0;
-        lone_lane(T, mesh, rc__lowest_bit(mask), child, T->count, geom, inst, &shrunk);
-        if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L);
+        if (pool) {
+            pool_add(pool, T, rc__lowest_bit(mask), child, T->count, mesh, geom, inst);
+        } else {
+            int shrunk = 0;
+            lone_lane(T, mesh, rc__lowest_bit(mask), child, T->count, geom, inst, &shrunk);
+            if (shrunk && T->P.usable) T->P.tmax = lanes_tmax(L);
+        }
     } else
 #endif
     if (T->count == 0) {
@@ -982,7 +1010,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
     do {
         if (T->sp == 0) {
             uint32_t i;
-            if (T->flags & RC__PACKET_PRIMS_PENDING) return 0;
+            if ((T->flags & RC__PACKET_PRIMS_PENDING) || pool) return 0;
             if (interleaved) {
                 /* a prim id is a read from refs, a miss on a large map:
                  * prefetch them and settle in a turn of their own */
@@ -1020,7 +1048,7 @@ void RC__PACKET_FN(rc__mesh_intersect_packet)(const rc__mesh *mesh, const rc__ra
         split_by_octant(&mesh, &geom, 1u, rays, n, inst, hits, found, flags);
         return;
     }
-    while (trav_step(&T, mesh, geom, inst, 0)) {
+    while (trav_step(&T, mesh, geom, inst, 0, NULL)) {
     }
 }
 
@@ -1057,7 +1085,7 @@ static void packet_meshes(const rc__mesh *const *meshes, const uint32_t *geoms, 
                 T.sp = T.child = T.count = 0;
                 T.staged = T.settling = 0;
             }
-            while (trav_step(&T, mesh, geoms[m], inst, 0)) {
+            while (trav_step(&T, mesh, geoms[m], inst, 0, NULL)) {
             }
         }
     for (; m < count; ++m) RC__PACKET_FN(rc__mesh_intersect_packet)(meshes[m], rays, n, geoms[m], inst, hits, found, flags);
@@ -1068,6 +1096,100 @@ void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *mesh
                                                      rc__hit *hits, int *found, uint32_t flags)
 {
     packet_meshes(meshes, geoms, count, rays, n, inst, hits, found, flags, 1);
+}
+#endif
+
+#if defined(RC__PACKET_LONE_LANE)
+/* Lone lanes taking turns (rc__mesh_intersect_packets): the packets run one
+ * by one, without turns, and each subtree one lane alone meets goes to a
+ * pool of POOL_SLOTS such lanes, each a resumable single-ray traversal
+ * (lone_lane's, a node or half a leaf a turn), which take turns while the
+ * pool is full and at the end. Deep in a map past the caches nearly every
+ * visit is a lone lane's (10M: 59% of the node visits and all but 0.2% of
+ * the leaf visits of packets taking turns), so the fetches overlap there,
+ * while the packets' steps above keep the cheaper bookkeeping of a packet
+ * alone. A lane's subtrees may be in the pool at once, and the packet may
+ * go on with that lane meanwhile: each offers its hits to the lane's
+ * nearest, whose tie rule does not depend on the order. */
+#define POOL_SLOTS 8u
+typedef struct lone_trav {
+    packet_trav *T; /* the lane's packet: its ray, tmax and hit */
+    uint32_t lane, child, count, sp;
+    uint32_t staged; /* 1 once the current leaf's vertices are prefetched */
+    int shrunk;
+    rc__wide_entry stack[PACKET_STACK + 4u]; /* room for one node's children past the end */
+} lone_trav;
+
+struct lone_pool {
+    lone_trav slot[POOL_SLOTS];
+    uint32_t live;
+};
+
+/* One turn of S: a node, or half a leaf (the first prefetches its
+ * vertices, the second tests them). 0 once its subtree is searched. */
+static RC__FORCE_INLINE int lone_step(lone_trav *S, const rc__mesh *mesh, uint32_t geom, uint32_t inst)
+{
+    packet_trav *const T = S->T;
+    const uint32_t lane = S->lane;
+    if (S->count == 0) {
+        rc__wide_entry *const e = S->stack + S->sp;
+        const uint32_t m = lone_node(T, mesh, lane, S->child, e);
+        if (m > 0) {
+            /* the nearest is visited next turn */
+            S->child = e[m - 1].child;
+            S->count = e[m - 1].count;
+            S->sp += m - 1u;
+            if (RC__UNLIKELY(S->sp > PACKET_STACK)) S->sp = PACKET_STACK;
+            return 1;
+        }
+    } else if (!S->staged) {
+        const float *vt[4][3];
+        const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, S->child, S->count, vt);
+        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, n_tri);
+        S->staged = 1;
+        return 1;
+    } else {
+        S->staged = 0;
+        lone_leaf(T, mesh, lane, S->child, S->count, geom, inst, &S->shrunk);
+    }
+    /* pop (with the box test's slack, as lone_lane) */
+    for (;;) {
+        if (S->sp == 0) {
+            if (S->shrunk && T->P.usable) T->P.tmax = lanes_tmax(&T->L);
+            return 0;
+        }
+        --S->sp;
+        if (S->stack[S->sp].tnear <= T->L.tmax[lane] * RC__SLAB_FAR_SCALE) break;
+    }
+    S->child = S->stack[S->sp].child;
+    S->count = S->stack[S->sp].count;
+    return 1;
+}
+
+/* Every searching lane of the pool takes one turn. */
+static void pool_round(lone_pool *pool, const rc__mesh *mesh, uint32_t geom, uint32_t inst)
+{
+    uint32_t k;
+    for (k = 0; k < POOL_SLOTS; ++k)
+        if (((pool->live >> k) & 1u) && !lone_step(&pool->slot[k], mesh, geom, inst)) pool->live &= ~(1u << k);
+}
+
+/* Lane lane of T searches subtree (child, count) in the pool: the pool
+ * takes turns until a slot is free. The entry was fetched when pushed. */
+static void pool_add(lone_pool *pool, packet_trav *T, uint32_t lane, uint32_t child, uint32_t count,
+                     const rc__mesh *mesh, uint32_t geom, uint32_t inst)
+{
+    lone_trav *S;
+    while (pool->live == (1u << POOL_SLOTS) - 1u) pool_round(pool, mesh, geom, inst);
+    S = &pool->slot[rc__lowest_bit(~pool->live)];
+    pool->live |= 1u << (uint32_t)(S - pool->slot);
+    S->T = T;
+    S->lane = lane;
+    S->child = child;
+    S->count = count;
+    S->sp = 0;
+    S->staged = 0;
+    S->shrunk = 0;
 }
 #endif
 
@@ -1082,6 +1204,30 @@ void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t pa
         RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[0], n[0], geom, inst, hits[0], found[0], flags);
         return;
     }
+#if defined(RC__PACKET_LONE_LANE)
+    {
+        lone_pool pool;
+        pool.live = 0;
+        for (k = 0; k < packets; ++k) {
+            if (!trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k], flags)) {
+                RC__PACKET_FN(rc__mesh_intersect_packet)(mesh, rays[k], n[k], geom, inst, hits[k], found[k], flags);
+                continue;
+            }
+            live |= 1u << k;
+            while (trav_step(&T[k], mesh, geom, inst, 0, &pool)) {
+            }
+        }
+        while (pool.live) pool_round(&pool, mesh, geom, inst);
+        /* the lanes' prim ids once every search is over */
+        if (!(flags & RC__PACKET_PRIMS_PENDING))
+            for (k = 0; k < packets; ++k)
+                if ((live >> k) & 1u) {
+                    uint32_t i;
+                    for (i = 0; i < n[k]; ++i) rc__hit_settle(&hits[k][i], mesh->bvh.refs);
+                }
+        return;
+    }
+#endif
     for (k = 0; k < packets; ++k) {
         if (trav_init(&T[k], mesh, rays[k], n[k], hits[k], found[k], flags))
             live |= 1u << k;
@@ -1092,7 +1238,7 @@ void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t pa
      * memory, the others work */
     while (live) {
         for (k = 0; k < packets; ++k)
-            if (((live >> k) & 1u) && !trav_step(&T[k], mesh, geom, inst, 1)) live &= ~(1u << k);
+            if (((live >> k) & 1u) && !trav_step(&T[k], mesh, geom, inst, 1, NULL)) live &= ~(1u << k);
     }
 }
 

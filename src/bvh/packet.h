@@ -58,8 +58,10 @@ void rc__mesh_intersect_packet_meshes(const rc__mesh *const *meshes, const uint3
                                       uint32_t flags);
 #endif
 
-/* Several packets at once, taking turns node by node so that one packet's
- * memory fetches overlap the others' work (same answers as one by one):
+/* Several packets at once, for a mesh past the caches: their lanes' fetches
+ * overlap (same answers as one by one). The packets run one by one and each
+ * subtree one lane alone meets joins a pool of such lanes taking turns node
+ * by node; in -Os builds the packets themselves take turns:
  * packet k is rays[k][0..n[k]) with hits[k] and found[k] as above. At most
  * RC__PACKETS_IN_FLIGHT packets; one goes the plain way. */
 #define RC__PACKETS_IN_FLIGHT 8u
