@@ -395,9 +395,11 @@ static void check_ordered(uint32_t backend, const rcu_mesh *sphere, const rcu_me
             assert_int_equal(simulate_all(ctx, scene, sensor, poses, &want), 0);
         }
         ctx->ordered_mesh_bytes = 0;
-        /* ordered packets taking turns (1 and 3 threads) and one tile at a
-         * time (2 threads: a map the cache nearly holds) */
+        /* ordered packets taking turns (1 thread), leaving their lone lanes
+         * to a pool taking turns (3 threads: a map far past the caches) and
+         * one tile at a time (2 threads: a map the cache nearly holds) */
         ctx->ordered_turns_bytes = threads == 2u ? UINT64_MAX : 0u;
+        ctx->lone_pool_bytes = threads == 3u ? 0u : UINT64_MAX;
         borrowed = simulate_all(ctx, scene, sensor, poses, &got);
         assert_true(borrowed >= (uint64_t)threads * 16u * TILES * ((POSES + threads - 1u) / threads));
         rct_assert_same_results(&want, &got);

@@ -204,8 +204,9 @@ static void packets_in_turns_equal_single(const packet_build *b, uint32_t flags)
     static rc__hit hits[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     static int found[RC__PACKETS_IN_FLIGHT][RC__PACKET_SIZE];
     uint32_t group, tile = 0, groups = rct_quick() ? 60u : 600u;
-    print_message("packets in turns: %s build%s%s\n", b->name, own_origins ? ", own origins" : "",
-                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "");
+    print_message("packets in turns: %s build%s%s%s\n", b->name, own_origins ? ", own origins" : "",
+                  flags & RC__PACKET_PRIMS_PENDING ? ", prim ids pending" : "",
+                  flags & RC__PACKET_LONE_POOL ? ", lone lanes in a pool" : "");
     map_open(&t);
     for (group = 0; group < groups; ++group) {
         const uint32_t k = 1u + group % RC__PACKETS_IN_FLIGHT;
@@ -526,6 +527,7 @@ static void test_packets_in_turns_equal_single(void **state)
 {
     (void)state;
     packets_in_turns_equal_single(&selected, 0);
+    packets_in_turns_equal_single(&selected, RC__PACKET_LONE_POOL);
 }
 
 /* OnDn packets: each ray from its own origin */
@@ -558,7 +560,7 @@ static void test_ties_equal_single(void **state)
     map_box_twice = 1;
     packet_equals_single(&selected, 0);
     packets_in_turns_equal_single(&selected, 0);
-    packets_in_turns_equal_single(&selected, RC__PACKET_OWN_ORIGINS);
+    packets_in_turns_equal_single(&selected, RC__PACKET_OWN_ORIGINS | RC__PACKET_LONE_POOL);
     map_box_twice = 0;
 }
 
@@ -592,10 +594,12 @@ static void test_both_builds_equal_single(void **state)
     (void)state;
 #if defined(RC__PACKET_TWO_BUILDS)
     uint32_t flags;
-    /* 0, own origins, prim ids pending, both */
+    /* 0, own origins, prim ids pending, both; each packets in turns and
+     * lone lanes in a pool */
     for (flags = 0; flags < 4u; ++flags) {
         packet_equals_single(&baseline, flags);
         packets_in_turns_equal_single(&baseline, flags);
+        packets_in_turns_equal_single(&baseline, flags | RC__PACKET_LONE_POOL);
     }
     if (!rc__leaf4_have_avx2()) {
         print_message("no AVX2 on this CPU: its build is not run\n");
@@ -604,6 +608,7 @@ static void test_both_builds_equal_single(void **state)
     for (flags = 0; flags < 4u; ++flags) {
         packet_equals_single(&avx2, flags);
         packets_in_turns_equal_single(&avx2, flags);
+        packets_in_turns_equal_single(&avx2, flags | RC__PACKET_LONE_POOL);
     }
 #else
     print_message("one build of the traversal on this target\n");

@@ -203,6 +203,9 @@ static void run_paths(const rcu_mesh *sphere, const rcu_mesh *box, uint64_t larg
         rc_sensor *o1dn, *ondn, *ondn_beams;
         assert_true(ctx->large_mesh_bytes >= RC__LARGE_MESH_BYTES);
         ctx->large_mesh_bytes = large_bytes;
+        /* a large mesh's packets take turns (1 thread) or leave their lone
+         * lanes to a pool (2 threads) */
+        ctx->lone_pool_bytes = threads == 2u ? large_bytes : UINT64_MAX;
         scene = make_scene(ctx, sphere, box, boxes, &src);
         assert_int_equal(rc__mesh_is_large(&scene->geoms[0].mesh, large_bytes), large_bytes == RC__LARGE_MESH_BYTES);
         o1dn = rct_sensor_dirs(ctx, dirs, rays, RANGE_MIN, RANGE_MAX);

@@ -79,6 +79,7 @@ typedef struct sim_run {
     size_t order_scratch_stride;
     uint32_t large;                  /* bit g: mesh g is large (rc__mesh_is_large), for scenes of
                                       * up to RC__PACKET_MAX_MESHES meshes */
+    uint32_t pooled;                 /* bit g: large mesh g past ctx->lone_pool_bytes too */
 #if defined(RC__PROJECTED_SCANS)
     rc__raster_grid grid;            /* projected scans: the sensor's grid */
     unsigned char *raster_scratch;   /* projected scans: raster_stride bytes per thread */
@@ -161,7 +162,12 @@ static void trace_group(const sim_run *run, const rc_scene *scene, uint32_t grou
         for (g = 0; g < direct; ++g) {
             const rc__mesh *mesh = &scene->geoms[g].mesh;
             if (group > 1 && ((run->large >> g) & 1u)) {
+#if defined(RC__PACKET_HAS_LONE_POOL)
+                rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound,
+                                           run->packet_flags | ((run->pooled >> g) & 1u ? RC__PACKET_LONE_POOL : 0u));
+#else
                 rc__mesh_intersect_packets(mesh, group, prays, n, g, RC_INVALID_ID, phits, pfound, run->packet_flags);
+#endif
             } else {
                 alone[alone_count] = mesh;
                 alone_geoms[alone_count++] = g;
@@ -607,7 +613,12 @@ static rc_status bvh_simulate(rc_context *ctx, const rc__sim_job *job)
     if (run.packets || job->scene->geom_count <= RC__PACKET_MAX_MESHES) {
         uint32_t g;
         for (g = 0; g < job->scene->geom_count && g < RC__PACKET_MAX_MESHES; ++g)
-            if (rc__mesh_is_large(&job->scene->geoms[g].mesh, ctx->large_mesh_bytes)) run.large |= 1u << g;
+            if (rc__mesh_is_large(&job->scene->geoms[g].mesh, ctx->large_mesh_bytes)) {
+                run.large |= 1u << g;
+#if defined(RC__PACKET_HAS_LONE_POOL)
+                if (rc__mesh_is_large(&job->scene->geoms[g].mesh, ctx->lone_pool_bytes)) run.pooled |= 1u << g;
+#endif
+            }
     }
     /* packets of a large mesh take turns (in a scene of many meshes, of
      * one among the first 32); single rays (OnDn) go mesh by mesh when a
@@ -654,7 +665,10 @@ static rc_status bvh_init(rc_context *ctx, const rc_context_desc *desc)
     const uint64_t llc = rc__last_level_cache_bytes();
     ctx->large_mesh_bytes = rc__large_mesh_threshold(llc);
     ctx->ordered_mesh_bytes = rc__ordered_mesh_threshold(llc);
-    ctx->ordered_turns_bytes = llc * 2u; /* 0 when unknown; it picks only how packets go */
+    ctx->ordered_turns_bytes = llc * 8u; /* 0 when unknown; it picks only how packets go */
+#if defined(RC__PACKET_HAS_LONE_POOL)
+    ctx->lone_pool_bytes = llc * 8u;
+#endif
 #if defined(RC__PROJECTED_SCANS)
     ctx->raster_edge_fraction = RC__RASTER_EDGE_FRACTION;
 #endif

@@ -1100,7 +1100,8 @@ void RC__PACKET_FN(rc__mesh_intersect_packet_meshes)(const rc__mesh *const *mesh
 #endif
 
 #if defined(RC__PACKET_LONE_LANE)
-/* Lone lanes taking turns (rc__mesh_intersect_packets): the packets run one
+/* Lone lanes taking turns (rc__mesh_intersect_packets with
+ * RC__PACKET_LONE_POOL, for a mesh far past the caches): the packets run one
  * by one, without turns, and each subtree one lane alone meets goes to a
  * pool of POOL_SLOTS such lanes, each a resumable single-ray traversal
  * (lone_lane's, a node or half a leaf a turn), which take turns while the
@@ -1205,7 +1206,7 @@ void RC__PACKET_FN(rc__mesh_intersect_packets)(const rc__mesh *mesh, uint32_t pa
         return;
     }
 #if defined(RC__PACKET_LONE_LANE)
-    {
+    if (flags & RC__PACKET_LONE_POOL) {
         lone_pool pool;
         pool.live = 0;
         for (k = 0; k < packets; ++k) {

@@ -37,6 +37,14 @@
  * instance and geometry first, and rc__hit_offer_slot resolves a pending id
  * only against its own mesh. */
 #define RC__PACKET_PRIMS_PENDING 2u
+/* rc__mesh_intersect_packets only: the packets run one by one and leave
+ * their lone lanes to a pool taking turns (a mesh far past the caches),
+ * instead of taking turns themselves. Not in -Os builds (the static core's
+ * size budget), which have no lone lanes: RC__PACKET_HAS_LONE_POOL says. */
+#define RC__PACKET_LONE_POOL 4u
+#if !defined(__OPTIMIZE_SIZE__)
+#define RC__PACKET_HAS_LONE_POOL 1
+#endif
 
 /* hits[i].t holds ray i's tmax on entry; found[i] is set to 1 where a hit
  * was recorded (found[] is not cleared). flags: RC__PACKET_* above. */
@@ -58,10 +66,10 @@ void rc__mesh_intersect_packet_meshes(const rc__mesh *const *meshes, const uint3
                                       uint32_t flags);
 #endif
 
-/* Several packets at once, for a mesh past the caches: their lanes' fetches
- * overlap (same answers as one by one). The packets run one by one and each
- * subtree one lane alone meets joins a pool of such lanes taking turns node
- * by node; in -Os builds the packets themselves take turns:
+/* Several packets at once, for a mesh past the caches: their fetches
+ * overlap (same answers as one by one). The packets take turns node by
+ * node, or with RC__PACKET_LONE_POOL run one by one, each subtree one lane
+ * alone meets joining a pool of such lanes that take turns:
  * packet k is rays[k][0..n[k]) with hits[k] and found[k] as above. At most
  * RC__PACKETS_IN_FLIGHT packets; one goes the plain way. */
 #define RC__PACKETS_IN_FLIGHT 8u

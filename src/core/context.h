@@ -36,13 +36,22 @@ struct rc_context {
      * (rc__ordered_mesh_threshold; UINT64_MAX: never). */
     uint64_t ordered_mesh_bytes;
     /* Ordered, the built-in backend's packets take turns only in meshes
-     * larger than this: twice the last-level cache (0 when its size is
-     * unknown: always). Ordered, a map the cache nearly holds is met mostly
-     * in cache, and the turns' bookkeeping costs more than it hides: on an
-     * AMD VM with a 32 MiB L3 (docs/benchmarks.md, session 27), VLP-16,
-     * 2 threads, one tile at a time against turns measured 1M triangles
-     * (30 MiB) +19%, 2M +5%, 4M +3.5%, 10M -3%. */
+     * larger than this: eight times the last-level cache (0 when its size
+     * is unknown: always). Ordered, a map the cache nearly holds is met
+     * mostly in cache, and the turns' bookkeeping costs more than it
+     * hides: on an AMD VM with a 32 MiB L3 (docs/benchmarks.md, session
+     * 27), VLP-16, 2 threads, one tile at a time against turns measured 1M
+     * triangles (30 MiB) +19%, 2M +5%, 4M +3.5%, 10M -3%; session 46, 1
+     * thread, against the lone lanes' pool: 2M (99 MiB) +15%, 5M (245 MiB)
+     * +7 to +10%, 10M (494 MiB) -8%. */
     uint64_t ordered_turns_bytes;
+    /* The built-in backend's packets of a mesh larger than this leave their
+     * lone lanes to a pool taking turns (RC__PACKET_LONE_POOL), where
+     * between large_mesh_bytes and this the packets themselves take turns:
+     * eight times the last-level cache (0 when unknown: every large mesh).
+     * Session 46, 1 thread, one pose a call (unordered): 1M -10% against the
+     * packets' turns, 10M +8%; ordered 2M +14%, 10M +9-10%. */
+    uint64_t lone_pool_bytes;
     /* A spinning sensor's projected scan needs every triangle's edges at
      * most this fraction of the map's bounding box diagonal (the built-in
      * backend's RC__RASTER_EDGE_FRACTION; tests raise it to put rooms

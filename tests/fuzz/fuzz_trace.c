@@ -39,7 +39,8 @@
 #define RANGE_MAX 1.0e6f
 
 /* The flags byte: bit 0 OnDn, bits 1-4 the grid step, bit 5 every mesh
- * counts as large (the traversals take turns), bits 6-7 the layout. */
+ * counts as large (the traversals take turns; their packets leave lone
+ * lanes to a pool where bit 1 is set), bits 6-7 the layout. */
 enum layout { ONE_MESH, MESHES, MESHES_AND_INSTANCES, INSTANCES_ONLY };
 
 static rc_context *ctx;
@@ -452,6 +453,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     ondn = flags & 1u;
     scale = ldexpf(1.0f, (int)((flags >> 1) & 15u) - 9); /* grid steps 1/512 .. 64 */
     ctx->large_mesh_bytes = (flags & 32u) ? 0u : default_large_bytes;
+    /* large meshes' packets: every other grid step leaves lone lanes to the pool */
+    ctx->lone_pool_bytes = (flags & 2u) ? 0u : UINT64_MAX;
     layout = (enum layout)(flags >> 6);
     tris = 1u + next(&r) % MAX_TRIS;
     /* the rays' byte: bits 0-5 the count, bit 6 a dynamic map (the meshes
