@@ -87,13 +87,18 @@ static RC__PREFETCH_INLINE void rc__prefetch_next(const rc__wnode *nodes, const 
     }
 }
 
-static RC__PREFETCH_INLINE void rc__leaf4_prefetch_vertices(const float *const v[4][3], uint32_t count)
+/* A leaf's vertices prefetched, for traversals taking turns: the turn
+ * before its test reads its index triples and starts the vertex loads. */
+static RC__PREFETCH_INLINE void rc__leaf4_stage(const uint32_t *leaf_tris, const float *vertices, size_t stride,
+                                                uint32_t first, uint32_t count)
 {
+    const float *vt[4][3];
+    const uint32_t n = rc__leaf4_vertices(leaf_tris, vertices, stride, first, count, vt);
     uint32_t i;
-    for (i = 0; i < count; ++i) {
-        RC__PREFETCH(v[i][0]);
-        RC__PREFETCH(v[i][1]);
-        RC__PREFETCH(v[i][2]);
+    for (i = 0; i < n; ++i) {
+        RC__PREFETCH(vt[i][0]);
+        RC__PREFETCH(vt[i][1]);
+        RC__PREFETCH(vt[i][2]);
     }
 }
 

@@ -941,9 +941,7 @@ static RC__FORCE_INLINE int trav_step(packet_trav *T, const rc__mesh *mesh, uint
             goto next;
         }
     } else if (interleaved && !T->staged) {
-        const float *vt[4][3];
-        const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count, vt);
-        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, n_tri);
+        rc__leaf4_stage(mesh->leaf_tris, mesh->vertices, mesh->stride, child, T->count);
         T->staged = 1;
         return 1;
     } else {
@@ -1144,9 +1142,7 @@ static RC__FORCE_INLINE int lone_step(lone_trav *S, const rc__mesh *mesh, uint32
             return 1;
         }
     } else if (!S->staged) {
-        const float *vt[4][3];
-        const uint32_t n_tri = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, S->child, S->count, vt);
-        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, n_tri);
+        rc__leaf4_stage(mesh->leaf_tris, mesh->vertices, mesh->stride, S->child, S->count);
         S->staged = 1;
         return 1;
     } else {

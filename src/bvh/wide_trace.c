@@ -227,9 +227,7 @@ static RC__FORCE_INLINE int turns_step(ray_turns *T, const rc__mesh *mesh, uint3
             return 1;
         }
     } else if (!T->staged) {
-        const float *vt[4][3];
-        const uint32_t count = rc__leaf4_vertices(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count, vt);
-        rc__leaf4_prefetch_vertices((const float *const(*)[3])vt, count);
+        rc__leaf4_stage(mesh->leaf_tris, mesh->vertices, mesh->stride, T->child, T->count);
         T->staged = 1;
         return 1;
     } else {
